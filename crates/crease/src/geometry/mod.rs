@@ -1,0 +1,19 @@
+//! Geometry: point clouds, triangle meshes with their edge topology, bounding boxes, spacing.
+
+mod aabb;
+mod attribute;
+pub mod cleanup;
+mod mesh;
+mod point_cloud;
+pub(crate) use point_cloud::retain_by;
+pub mod spacing;
+pub mod topology;
+pub mod vec3;
+
+pub use aabb::Aabb;
+pub use attribute::{Attribute, Attributes, ScalarKind};
+pub use cleanup::{clean_mesh, CleanupParams, CleanupReport};
+pub use mesh::TriMesh;
+pub use point_cloud::{Point3, PointCloud};
+pub use spacing::{average_spacing, average_spacing_with};
+pub use topology::MeshTopology;

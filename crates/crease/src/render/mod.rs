@@ -1,0 +1,1 @@
+//! PNG quick-looks (to be written).

@@ -1,0 +1,5 @@
+//! Spatial queries: nearest neighbours over point sets.
+
+mod kdtree;
+
+pub use kdtree::KdIndex;

@@ -1,0 +1,1 @@
+//! Synthetic parts (to be written).
