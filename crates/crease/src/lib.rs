@@ -7,7 +7,4 @@
 //! file ──io──▶ PointCloud / TriMesh ──spatial──▶ neighbourhoods ──estimate──▶ normals, curvature
 //!                                                      │
 //!          sharp · lines · fillets · meshfeat · segment ◀┘ ──▶ eval · io · render
-//! use crease::synth::{Shape, SampleParams};
-//! let part = crease::synth::sample_points(&Shape::default_cube(), &SampleParams { n: 2000, ..Default::default() }).unwrap();
-//! let spacing = crease::geometry::average_spacing(&part.cloud.positions).unwrap();
-//! assert!(spacing > 0.0);
+//! ```
