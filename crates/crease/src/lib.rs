@@ -8,3 +8,16 @@
 //!                                                      │
 //!          sharp · lines · fillets · meshfeat · segment ◀┘ ──▶ eval · io · render
 //! ```
+//!
+//! Each stage is a plain function: inputs and a `Params` struct in, a result struct out.
+
+pub mod error;
+pub mod geometry;
+pub mod io;
+pub mod render;
+pub mod spatial;
+pub mod synth;
+
+pub use error::{Error, Result};
+pub use geometry::{Aabb, Attribute, PointCloud, TriMesh};
+pub use io::Geometry;

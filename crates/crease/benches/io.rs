@@ -1,0 +1,2 @@
+//! I/O benchmarks (to be written).
+fn main() {}
