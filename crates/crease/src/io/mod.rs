@@ -20,6 +20,7 @@ pub mod off;
 pub mod pcd;
 pub mod ply;
 pub mod stl;
+pub mod summary;
 pub mod xyz;
 
 /// Everything a file may hold: points (with per-point data), triangles, and line segments /

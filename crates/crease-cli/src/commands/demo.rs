@@ -1,0 +1,171 @@
+//! `crease demo`: runs every capability crease has on a built-in synthetic part, with no input
+//! files, and writes the results (PLY, polylines, PNG, JSON summary) into one folder.
+
+use std::path::Path;
+
+use anyhow::Context;
+use crease::render::{ColorBy, RenderParams, Scene, ViewLayout};
+use crease::synth::{self, MeshParams, Noise, NoiseScale, SampleParams, Shape};
+
+use crate::args::Global;
+use crate::ui::Stage;
+
+/// The demo part: a block with a fillet, a chamfer and a cone: sharp edges, smooth (fillet)
+/// edges and four kinds of analytic surfaces in one part.
+const SHAPE: &str = "fillet-chamfer-cone";
+
+pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
+    if n < 1000 {
+        return Err(crate::ui::usage(format!(
+            "-n {n}: the demo needs at least 1000 points"
+        )));
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let shape = Shape::from_name(SHAPE).context("built-in demo shape missing")?;
+    let mut timings = serde_json::Map::new();
+    let mut time = |name: &str, stage: Stage| {
+        timings.insert(name.to_string(), serde_json::json!(stage.finish()));
+    };
+
+    // 1. A scanned-like point cloud: noise of 10 % of the spacing along the normal.
+    let s = Stage::start("sampling the part", g.quiet);
+    let part = synth::sample_points(
+        &shape,
+        &SampleParams {
+            n,
+            noise: Noise::AlongNormal(0.1),
+            noise_scale: NoiseScale::Spacing,
+            seed: 7,
+            ..Default::default()
+        },
+    )?;
+    time("sample_points", s);
+    let cloud_path = dir.join("part.ply");
+    let curves_path = dir.join("part.curves.ply");
+    let s = Stage::start("writing", g.quiet);
+    let cloud_geom = crease::io::Geometry::from_cloud(part.cloud.clone());
+    super::save(g, &cloud_path, &cloud_geom, false, &[])?;
+    let curves = part.curves_geometry();
+    super::save(g, &curves_path, &curves, false, &[])?;
+    std::fs::write(
+        dir.join("part.truth.json"),
+        serde_json::to_string_pretty(&part.ground_truth_json())?,
+    )?;
+    time("write", s);
+
+    // 2. The same part as a triangle mesh.
+    let s = Stage::start("meshing the part", g.quiet);
+    let m = synth::mesh(&shape, &MeshParams::default())?;
+    time("mesh", s);
+    let mesh_path = dir.join("part-mesh.ply");
+    let mesh_faces = m.mesh.num_faces();
+    let mesh_vertices = m.mesh.num_vertices();
+    let topo = crease::geometry::MeshTopology::new(&m.mesh);
+    let mesh_curves = m.curves_geometry();
+    super::save(
+        g,
+        &mesh_path,
+        &crease::io::Geometry::from_mesh(m.mesh.clone()),
+        false,
+        &[],
+    )?;
+
+    // 3. Reading back and summarising, as `crease info` does.
+    let s = Stage::start("reading back", g.quiet);
+    let (back, report) = crease::io::read(&cloud_path, &Default::default())?;
+    let summary = crease::io::summary::summarize(&back, &report);
+    time("read_and_summarize", s);
+
+    // 4. Pictures.
+    let s = Stage::start("rendering", g.quiet);
+    let lines = super::render::polylines_of(&curves, 0);
+    let pictures = [
+        (
+            "part-sharp.png",
+            "gt_sharp",
+            "ground truth: sharp points and feature curves",
+        ),
+        (
+            "part-surfaces.png",
+            "gt_surface_type",
+            "ground truth: surface types",
+        ),
+    ];
+    for (file, attr, title) in pictures {
+        let scene = Scene {
+            points: Some(&part.cloud),
+            mesh: None,
+            polylines: lines.clone(),
+        };
+        let params = RenderParams {
+            layout: ViewLayout::Four,
+            color_by: ColorBy::Attribute(attr.into()),
+            title: Some(format!("{SHAPE}, {n} points - {title}")),
+            ..Default::default()
+        };
+        crease::render::render_png(&scene, &params, &dir.join(file))?;
+    }
+    let scene = Scene {
+        points: None,
+        mesh: Some(&m.mesh),
+        polylines: super::render::polylines_of(&mesh_curves, 0),
+    };
+    let params = RenderParams {
+        color_by: ColorBy::Attribute("gt_surface_type".into()),
+        title: Some(format!("{SHAPE}, mesh of {mesh_faces} triangles")),
+        ..Default::default()
+    };
+    crease::render::render_png(&scene, &params, &dir.join("part-mesh.png"))?;
+    time("render", s);
+
+    let sharp = part
+        .cloud
+        .attribute("gt_sharp")
+        .map(|a| a.values.iter().filter(|v| **v > 0.0).count())
+        .unwrap_or(0);
+    let result = serde_json::json!({
+        "shape": SHAPE,
+        "points": part.cloud.len(),
+        "spacing": summary.spacing,
+        "sharp_points": sharp,
+        "surfaces": part.surfaces.len(),
+        "curves": part.curves.len(),
+        "mesh": {
+            "vertices": mesh_vertices,
+            "faces": mesh_faces,
+            "edges": topo.edges.len(),
+            "closed_manifold": topo.is_closed_manifold(),
+        },
+        "files": ["part.ply", "part.curves.ply", "part.truth.json", "part-mesh.ply",
+                  "part-sharp.png", "part-surfaces.png", "part-mesh.png"],
+        "seconds": timings,
+    });
+    std::fs::write(
+        dir.join("summary.json"),
+        serde_json::to_string_pretty(&result)?,
+    )?;
+    if g.json {
+        crate::ui::print_json(&result)?;
+    } else if !g.quiet {
+        println!(
+            "crease demo: {SHAPE} sampled with {} points (spacing {:.5}), {} of them within one spacing of a sharp edge;",
+            part.cloud.len(),
+            summary.spacing.unwrap_or(0.0),
+            sharp
+        );
+        println!(
+            "{} analytic surfaces, {} feature curves; mesh of {} vertices / {} triangles ({}).",
+            part.surfaces.len(),
+            part.curves.len(),
+            mesh_vertices,
+            mesh_faces,
+            if topo.is_closed_manifold() {
+                "closed manifold"
+            } else {
+                "open"
+            }
+        );
+        println!("results in {}/: {}", dir.display(), result["files"]);
+    }
+    Ok(())
+}

@@ -1,0 +1,63 @@
+//! One module per subcommand; each reads its inputs, calls the library, writes its outputs.
+
+mod convert;
+mod demo;
+mod info;
+mod render;
+mod synth;
+
+use std::path::Path;
+
+use anyhow::Context;
+use crease::io::{Geometry, ReadOptions, ReadReport};
+
+use crate::args::{Cli, Command, Global};
+use crate::ui::Stage;
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    let g = &cli.global;
+    match cli.command {
+        Command::Info { input } => info::run(g, &input),
+        Command::Convert {
+            input,
+            output,
+            ascii,
+        } => convert::run(g, &input, &output, ascii),
+        Command::Synth(a) => synth::run(g, &a),
+        Command::Render(a) => render::run(g, &a),
+        Command::Demo { output, n } => demo::run(g, &output, n),
+    }
+}
+
+/// Reads any supported file, with a spinner, reporting dropped points as a warning.
+pub fn load(g: &Global, path: &Path) -> anyhow::Result<(Geometry, ReadReport)> {
+    let stage = Stage::start(&format!("reading {}", path.display()), g.quiet);
+    let opts = ReadOptions { strict: g.strict };
+    let (geom, report) = crease::io::read(path, &opts)?;
+    stage.finish();
+    if report.dropped_nonfinite > 0 {
+        tracing::warn!(
+            "{}: dropped {} points with NaN or infinite coordinates (use --strict to refuse such files)",
+            path.display(),
+            report.dropped_nonfinite
+        );
+    }
+    Ok((geom, report))
+}
+
+/// Writes `geom` to `path`, refusing to overwrite any of `inputs`.
+pub fn save(
+    g: &Global,
+    path: &Path,
+    geom: &Geometry,
+    ascii: bool,
+    inputs: &[&Path],
+) -> anyhow::Result<()> {
+    crate::ui::ensure_not_input(path, inputs)?;
+    let stage = Stage::start(&format!("writing {}", path.display()), g.quiet);
+    crease::io::write(path, geom, &crease::io::WriteOptions { ascii })
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    stage.finish();
+    Ok(())
+}

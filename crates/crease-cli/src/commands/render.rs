@@ -1,0 +1,108 @@
+//! `crease render IN -o view.png`: a quick-look PNG of points, meshes and polylines.
+
+use std::path::Path;
+
+use anyhow::Context;
+use crease::render::{ColorBy, Polyline, RenderParams, Scene, View, ViewLayout};
+
+use crate::args::{Global, RenderArgs, ViewArg};
+use crate::ui::Stage;
+
+pub fn run(g: &Global, a: &RenderArgs) -> anyhow::Result<()> {
+    let mut inputs: Vec<&Path> = vec![&a.input];
+    inputs.extend(a.lines.iter().map(|p| p.as_path()));
+    crate::ui::ensure_not_input(&a.output, &inputs)?;
+    let (geom, _) = super::load(g, &a.input)?;
+    let mut polylines = Vec::new();
+    for (i, path) in a.lines.iter().enumerate() {
+        let (lines, _) = super::load(g, path)?;
+        polylines.extend(polylines_of(&lines, i));
+    }
+    // The input's own polylines / edges are drawn too.
+    polylines.extend(polylines_of(&geom, a.lines.len()));
+    let color_by = match a.color_by.as_deref() {
+        None if geom.points.colors.is_some() => ColorBy::Rgb,
+        None | Some("uniform") => ColorBy::Uniform,
+        Some("rgb") => ColorBy::Rgb,
+        Some("normal") => ColorBy::Normal,
+        Some(name) => ColorBy::Attribute(name.to_string()),
+    };
+    let layout = match a.view {
+        None => ViewLayout::Four,
+        Some(ViewArg::Iso) => ViewLayout::Single(View::Iso),
+        Some(ViewArg::Front) => ViewLayout::Single(View::Front),
+        Some(ViewArg::Top) => ViewLayout::Single(View::Top),
+        Some(ViewArg::Side) => ViewLayout::Single(View::Side),
+    };
+    let params = RenderParams {
+        width: a.width,
+        height: a.height,
+        layout,
+        color_by,
+        title: Some(a.title.clone().unwrap_or_else(|| {
+            a.input
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        })),
+        ..Default::default()
+    };
+    let mesh = geom.clone().into_mesh();
+    let scene = Scene {
+        points: if mesh.is_none() && geom.edges.is_empty() && geom.polylines.is_empty()
+            || mesh.is_none() && !geom.points.is_empty()
+        {
+            Some(&geom.points)
+        } else {
+            None
+        },
+        mesh: mesh.as_ref(),
+        polylines,
+    };
+    let stage = Stage::start("rendering", g.quiet);
+    crease::render::render_png(&scene, &params, &a.output)
+        .with_context(|| format!("cannot render {}", a.input.display()))?;
+    let t = stage.finish();
+    if g.json {
+        crate::ui::print_json(&serde_json::json!({
+            "input": a.input, "output": a.output, "seconds": t,
+        }))?;
+    } else if !g.quiet {
+        eprintln!("wrote {}", a.output.display());
+    }
+    Ok(())
+}
+
+/// The polylines and edges of `geom` as drawable polylines. Curves tagged by a `kind` edge
+/// attribute (0 sharp, 1 smooth, 2 boundary, as `crease synth` writes them) get their colours.
+pub fn polylines_of(geom: &crease::io::Geometry, file_index: usize) -> Vec<Polyline> {
+    let pts = &geom.points.positions;
+    let palette = [[220, 30, 30], [30, 90, 220], [40, 160, 60], [200, 120, 0]];
+    let default = palette[file_index % palette.len()];
+    let mut out = Vec::new();
+    for l in &geom.polylines {
+        let closed = l.len() > 2 && l.first() == l.last();
+        out.push(Polyline {
+            points: l.iter().map(|&i| pts[i as usize]).collect(),
+            closed,
+            color: default,
+            label: None,
+        });
+    }
+    let kind = geom.edge_attributes.get("kind");
+    for (i, e) in geom.edges.iter().enumerate() {
+        let (color, label) = match kind.map(|k| k.values[i] as i64) {
+            Some(0) => ([220, 30, 30], Some("sharp")),
+            Some(1) => ([30, 90, 220], Some("smooth")),
+            Some(2) => ([110, 110, 110], Some("boundary")),
+            _ => (default, None),
+        };
+        out.push(Polyline {
+            points: vec![pts[e[0] as usize], pts[e[1] as usize]],
+            closed: false,
+            color,
+            label: label.map(String::from),
+        });
+    }
+    out
+}

@@ -1,0 +1,121 @@
+//! Terminal plumbing: logging, progress spinners, usage errors, output-path checks.
+
+use std::io::IsTerminal;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// An error in how the command was called (exit code 2), as opposed to a failure (exit code 1).
+#[derive(Debug)]
+pub struct UsageError(pub String);
+
+impl std::fmt::Display for UsageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
+
+/// A usage error as an `anyhow::Error`.
+pub fn usage(msg: impl Into<String>) -> anyhow::Error {
+    anyhow::Error::new(UsageError(msg.into()))
+}
+
+/// Sets up tracing on stderr: warnings by default, more with -v, errors only with --quiet.
+/// `RUST_LOG` overrides.
+pub fn init_logging(verbose: u8, quiet: bool) {
+    let level = if quiet {
+        "error"
+    } else {
+        match verbose {
+            0 => "warn",
+            1 => "info",
+            2 => "debug",
+            _ => "trace",
+        }
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(level));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_target(false)
+        .try_init();
+}
+
+/// A spinner on stderr for one stage of work, shown only when stderr is a terminal (and not
+/// `--quiet`), and only once the stage has run for a second. Logs the stage's time at info level.
+pub struct Stage {
+    name: String,
+    start: Instant,
+    bar: Option<ProgressBar>,
+}
+
+impl Stage {
+    /// Starts a stage called `name`.
+    pub fn start(name: &str, quiet: bool) -> Stage {
+        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+            let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+            bar.set_style(
+                ProgressStyle::with_template("{spinner} {msg} {elapsed}")
+                    .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+            );
+            bar.set_message(name.to_string());
+            // The first tick is drawn after a second, so quick stages never show a bar.
+            bar.enable_steady_tick(Duration::from_millis(1000));
+            bar
+        });
+        Stage {
+            name: name.to_string(),
+            start: Instant::now(),
+            bar,
+        }
+    }
+
+    /// Ends the stage and returns its duration in seconds.
+    pub fn finish(self) -> f64 {
+        let t = self.start.elapsed().as_secs_f64();
+        if let Some(b) = self.bar {
+            b.finish_and_clear();
+        }
+        tracing::info!("{}: {:.3} s", self.name, t);
+        t
+    }
+}
+
+/// Refuses to write `output` if it is one of the `inputs` (never overwrite the input file).
+pub fn ensure_not_input(output: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
+    let out = canonical(output);
+    for inp in inputs {
+        if canonical(inp) == out {
+            return Err(usage(format!(
+                "{}: the output file is the input file; crease never overwrites its input, choose another output name",
+                output.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The canonical form of a path that may not exist yet (its parent canonicalised).
+fn canonical(p: &Path) -> std::path::PathBuf {
+    if let Ok(c) = p.canonicalize() {
+        return c;
+    }
+    let parent = p
+        .parent()
+        .filter(|q| !q.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    match (parent.canonicalize(), p.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => p.to_path_buf(),
+    }
+}
+
+/// Prints `value` as pretty JSON on stdout.
+pub fn print_json(value: &serde_json::Value) -> anyhow::Result<()> {
+    println!("{}", serde_json::to_string_pretty(value)?);
+    Ok(())
+}

@@ -1,0 +1,295 @@
+//! End-to-end tests of the `crease` binary: real data loads, bad input gives clear errors and
+//! the right exit codes, outputs never overwrite inputs, and the commands' outputs are correct.
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+
+fn crease() -> Command {
+    Command::cargo_bin("crease").expect("the crease binary is built")
+}
+
+fn data_dir() -> Option<PathBuf> {
+    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
+    if d.is_dir() {
+        return Some(d);
+    }
+    assert!(
+        std::env::var("CI").map(|v| v != "true").unwrap_or(true),
+        "CI=true but the shared test data is missing at {}",
+        d.display()
+    );
+    eprintln!("skipping: shared data not found at {}", d.display());
+    None
+}
+
+fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<_> = std::fs::read_dir(dir)
+        .expect("readable directory")
+        .map(|e| e.expect("directory entry").path())
+        .collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            files_under(&p, out);
+        } else {
+            out.push(p);
+        }
+    }
+}
+
+fn json_of(out: &[u8]) -> serde_json::Value {
+    serde_json::from_slice(out).expect("--json prints valid JSON on stdout")
+}
+
+#[test]
+fn every_shared_data_file_loads_with_info() {
+    let Some(dir) = data_dir() else { return };
+    let mut files = Vec::new();
+    files_under(&dir, &mut files);
+    let geometry_exts = ["ply", "obj", "off", "stl", "xyz", "pcd", "las", "laz", "e57"];
+    let mut checked = 0;
+    for f in files {
+        let ext = f
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        if !geometry_exts.contains(&ext.as_str()) {
+            continue;
+        }
+        let out = crease().arg("info").arg("--json").arg(&f).output().unwrap();
+        assert!(
+            out.status.success(),
+            "crease info {} failed: {}",
+            f.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v = json_of(&out.stdout);
+        let points = v["points"].as_u64().unwrap_or(0);
+        assert!(points >= 1000, "{}: only {points} points", f.display());
+        assert!(
+            v["spacing"].as_f64().unwrap_or(0.0) > 0.0,
+            "{}: no spacing",
+            f.display()
+        );
+        checked += 1;
+    }
+    assert!(checked >= 38, "only {checked} data files found");
+}
+
+#[test]
+fn info_reports_known_counts() {
+    let Some(dir) = data_dir() else { return };
+    let out = crease()
+        .args(["info", "--json"])
+        .arg(dir.join("meshes/fandisk.off"))
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v = json_of(&out.stdout);
+    assert_eq!(v["kind"], "triangle mesh");
+    assert_eq!(v["points"], 7229);
+    assert_eq!(v["faces"], 14454);
+}
+
+/// Every file of the bad-input corpus fails with exit code 1 and a message naming the file,
+/// except the files with NaN coordinates, which load with the bad points dropped and fail with
+/// --strict.
+#[test]
+fn bad_input_corpus_gives_clear_errors() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../crease/tests/bad_input");
+    let mut files = Vec::new();
+    files_under(&dir, &mut files);
+    assert!(files.len() >= 20, "bad-input corpus too small: {}", files.len());
+    for f in files {
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        let nan = name.contains("nan");
+        let mut cmd = crease();
+        cmd.arg("info").arg(&f);
+        if nan {
+            let out = crease().arg("info").arg(&f).output().unwrap();
+            assert!(out.status.success(), "{name}: NaN points should be dropped");
+            assert!(
+                String::from_utf8_lossy(&out.stdout).contains("NaN"),
+                "{name}: the dropped points are reported"
+            );
+            cmd.arg("--strict");
+        }
+        let out = cmd.output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{name}: exit code, stderr {stderr}");
+        assert!(
+            stderr.starts_with("error: ") && stderr.contains(&name),
+            "{name}: message must name the file: {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{name}: panic: {stderr}");
+    }
+}
+
+#[test]
+fn unknown_format_and_missing_file_are_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    let f = tmp.path().join("cloud.abc");
+    std::fs::write(&f, "1 2 3\n").unwrap();
+    let out = crease().arg("info").arg(&f).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("cloud.abc") && e.contains("unknown file format"), "{e}");
+
+    let out = crease()
+        .arg("info")
+        .arg(tmp.path().join("missing.ply"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("missing.ply"));
+
+    // A usage error is exit code 2.
+    let out = crease().arg("frobnicate").output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn convert_never_overwrites_its_input() {
+    let tmp = tempfile::tempdir().unwrap();
+    let f = tmp.path().join("pts.xyz");
+    let text = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+    std::fs::write(&f, text).unwrap();
+    let out = crease().arg("convert").arg(&f).arg(&f).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("never overwrites"));
+    // The same file reached by another path.
+    let other = tmp.path().join(".").join("pts.xyz");
+    let out = crease().arg("convert").arg(&f).arg(&other).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&f).unwrap(), text);
+}
+
+#[test]
+fn convert_round_trips_through_every_writable_format() {
+    let tmp = tempfile::tempdir().unwrap();
+    let src = tmp.path().join("cube.ply");
+    let out = crease()
+        .args(["synth", "cube", "--mesh", "-o"])
+        .arg(&src)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let info = |p: &Path| {
+        let o = crease().args(["info", "--json"]).arg(p).output().unwrap();
+        assert!(o.status.success(), "{}: {}", p.display(), String::from_utf8_lossy(&o.stderr));
+        json_of(&o.stdout)
+    };
+    let base = info(&src);
+    for ext in ["obj", "off", "stl", "ply"] {
+        let dst = tmp.path().join(format!("converted.{ext}"));
+        let o = crease().arg("convert").arg(&src).arg(&dst).output().unwrap();
+        assert!(o.status.success(), "{ext}: {}", String::from_utf8_lossy(&o.stderr));
+        let v = info(&dst);
+        assert_eq!(v["faces"], base["faces"], "{ext}");
+        assert_eq!(v["points"], base["points"], "{ext}");
+    }
+    for ext in ["xyz", "pcd", "las", "laz", "e57"] {
+        let dst = tmp.path().join(format!("converted.{ext}"));
+        let o = crease().arg("convert").arg(&src).arg(&dst).output().unwrap();
+        assert!(o.status.success(), "{ext}: {}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(info(&dst)["points"], base["points"], "{ext}");
+    }
+}
+
+#[test]
+fn synth_writes_exact_ground_truth() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out_path = tmp.path().join("cube.ply");
+    let o = crease()
+        .args(["synth", "cube", "-n", "20000", "--json", "-o"])
+        .arg(&out_path)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v = json_of(&o.stdout);
+    assert_eq!(v["points"], 20000);
+    assert!(tmp.path().join("cube.curves.ply").is_file());
+    assert!(tmp.path().join("cube.truth.json").is_file());
+    let o = crease().args(["info", "--json"]).arg(&out_path).output().unwrap();
+    let info = json_of(&o.stdout);
+    let names: Vec<&str> = info["attributes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["name"].as_str().unwrap())
+        .collect();
+    for want in ["gt_sharp", "gt_edge_distance", "gt_surface", "gt_surface_type"] {
+        assert!(names.contains(&want), "{want} missing from {names:?}");
+    }
+    // Six planes, all of surface type 0.
+    let st = info["attributes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == "gt_surface_type")
+        .unwrap();
+    assert_eq!(st["histogram"].as_array().unwrap().len(), 1);
+    assert!(info["normals"].as_bool().unwrap());
+
+    let o = crease().args(["synth", "no-such-shape", "-o"]).arg(&out_path).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("known shapes"));
+}
+
+#[test]
+fn render_writes_a_png() {
+    let tmp = tempfile::tempdir().unwrap();
+    let pts = tmp.path().join("cube.ply");
+    assert!(crease()
+        .args(["synth", "cube", "-n", "5000", "-o"])
+        .arg(&pts)
+        .output()
+        .unwrap()
+        .status
+        .success());
+    let png = tmp.path().join("view.png");
+    let o = crease()
+        .arg("render")
+        .arg(&pts)
+        .args(["--color-by", "gt_sharp", "--lines"])
+        .arg(tmp.path().join("cube.curves.ply"))
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    // An attribute the file does not have is an error that lists the available ones.
+    let o = crease()
+        .arg("render")
+        .arg(&pts)
+        .args(["--color-by", "nope", "-o"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("gt_sharp"));
+}
+
+#[test]
+fn demo_writes_its_results() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("demo");
+    let o = crease()
+        .args(["demo", "-n", "20000", "--json", "-o"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v = json_of(&o.stdout);
+    for f in v["files"].as_array().unwrap() {
+        let p = dir.join(f.as_str().unwrap());
+        assert!(p.is_file() && std::fs::metadata(&p).unwrap().len() > 0, "{}", p.display());
+    }
+    assert_eq!(v["points"], 20000);
+    assert!(v["sharp_points"].as_u64().unwrap() > 0);
+    assert_eq!(v["mesh"]["closed_manifold"], true);
+}
