@@ -19,7 +19,11 @@ fn sample_cloud(n: usize, offset: f64) -> PointCloud {
         .map(|i| {
             let u = (i % 37) as f64 / 37.0;
             let v = (i / 37) as f64 / 11.0;
-            [offset + u * 1.7, offset - v * 0.9, offset + 0.3 * u * v + 0.123456789]
+            [
+                offset + u * 1.7,
+                offset - v * 0.9,
+                offset + 0.3 * u * v + 0.123456789,
+            ]
         })
         .collect();
     let mut c = PointCloud::from_positions(positions);
@@ -34,7 +38,13 @@ fn sample_cloud(n: usize, offset: f64) -> PointCloud {
     .unwrap();
     c.set_colors(
         (0..n)
-            .map(|i| [(i * 7 % 256) as u8, (i * 13 % 256) as u8, (255 - i % 256) as u8])
+            .map(|i| {
+                [
+                    (i * 7 % 256) as u8,
+                    (i * 13 % 256) as u8,
+                    (255 - i % 256) as u8,
+                ]
+            })
             .collect(),
     )
     .unwrap();
@@ -98,7 +108,11 @@ fn kinect_pcds_load_with_missing_points_dropped() {
         assert!(n > 100_000 && n < 307_200, "{name}: {n} points");
         assert_eq!(n + r.dropped_missing, 640 * 480, "{name}");
         assert_eq!(r.dropped_nonfinite, 0, "{name}");
-        assert!(r.encoding.starts_with("binary_compressed"), "{}", r.encoding);
+        assert!(
+            r.encoding.starts_with("binary_compressed"),
+            "{}",
+            r.encoding
+        );
         assert!(g
             .points
             .positions
@@ -111,11 +125,7 @@ fn kinect_pcds_load_with_missing_points_dropped() {
         let label = g.points.attribute("label").expect("label field");
         assert_eq!(label.kind, ScalarKind::U32);
         // Kinect depth: points lie in front of the sensor, within a few metres.
-        assert!(g
-            .points
-            .positions
-            .iter()
-            .all(|p| p[2] > 0.2 && p[2] < 10.0));
+        assert!(g.points.positions.iter().all(|p| p[2] > 0.2 && p[2] < 10.0));
     }
 }
 
@@ -174,7 +184,12 @@ fn pcd_far_from_origin_uses_doubles() {
     let c = sample_cloud(300, 5.0e5);
     for ascii in [false, true] {
         let p = dir.path().join("far.pcd");
-        io::write(&p, &Geometry::from_cloud(c.clone()), &WriteOptions { ascii }).unwrap();
+        io::write(
+            &p,
+            &Geometry::from_cloud(c.clone()),
+            &WriteOptions { ascii },
+        )
+        .unwrap();
         let text = std::fs::read(&p).unwrap();
         assert!(String::from_utf8_lossy(&text[..400]).contains("SIZE 8 8 8 4"));
         let (back, _) = io::read_cloud(&p, &ReadOptions::default()).unwrap();
@@ -221,13 +236,24 @@ fn pcd_binary_compressed_hand_encoded() {
             if i % 7 == 3 {
                 [f32::NAN; 3]
             } else {
-                [(i % w) as f32 * 0.01, (i / w) as f32 * 0.01, 1.0 + (i % 5) as f32 * 0.001]
+                [
+                    (i % w) as f32 * 0.01,
+                    (i / w) as f32 * 0.01,
+                    1.0 + (i % 5) as f32 * 0.001,
+                ]
             }
         })
         .collect();
     // Bytes B G R A, as PCL packs them.
     let rgb: Vec<u32> = (0..n)
-        .map(|i| u32::from_le_bytes([(i % 256) as u8, (i * 3 % 256) as u8, (i * 5 % 256) as u8, 255]))
+        .map(|i| {
+            u32::from_le_bytes([
+                (i % 256) as u8,
+                (i * 3 % 256) as u8,
+                (i * 5 % 256) as u8,
+                255,
+            ])
+        })
         .collect();
     let label: Vec<u16> = (0..n).map(|i| (i * 11 % 65536) as u16).collect();
     let p = dir.path().join("c.pcd");
@@ -243,7 +269,10 @@ fn pcd_binary_compressed_hand_encoded() {
             g.points.colors.as_ref().unwrap()[j],
             [(i * 5 % 256) as u8, (i * 3 % 256) as u8, (i % 256) as u8]
         );
-        assert_eq!(g.points.attribute("label").unwrap().values[j], label[i] as f64);
+        assert_eq!(
+            g.points.attribute("label").unwrap().values[j],
+            label[i] as f64
+        );
     }
     assert_eq!(g.points.attribute("label").unwrap().kind, ScalarKind::U16);
 
@@ -284,7 +313,10 @@ fn las_and_laz_round_trip() {
                 "{name}"
             );
         }
-        assert_eq!(back.attribute("classification").unwrap().kind, ScalarKind::U8);
+        assert_eq!(
+            back.attribute("classification").unwrap().kind,
+            ScalarKind::U8
+        );
         assert_eq!(back.attribute("intensity").unwrap().kind, ScalarKind::U16);
         assert!(back.attribute("gps_time").is_none());
     }
@@ -308,7 +340,12 @@ fn las_extended_classes_and_gps_time() {
     })
     .unwrap();
     let p = dir.path().join("x.laz");
-    io::write(&p, &Geometry::from_cloud(c.clone()), &WriteOptions::default()).unwrap();
+    io::write(
+        &p,
+        &Geometry::from_cloud(c.clone()),
+        &WriteOptions::default(),
+    )
+    .unwrap();
     let (back, r) = io::read_cloud(&p, &ReadOptions::default()).unwrap();
     assert!(r.encoding.contains("point format 6"), "{}", r.encoding);
     assert_eq!(back.colors, None);
@@ -326,7 +363,12 @@ fn e57_round_trip() {
     let dir = common::tempdir();
     let c = sample_cloud(1500, -3.25);
     let p = dir.path().join("r.e57");
-    io::write(&p, &Geometry::from_cloud(c.clone()), &WriteOptions::default()).unwrap();
+    io::write(
+        &p,
+        &Geometry::from_cloud(c.clone()),
+        &WriteOptions::default(),
+    )
+    .unwrap();
     let (back, r) = io::read_cloud(&p, &ReadOptions::default()).unwrap();
     assert_eq!(back.positions, c.positions);
     assert_eq!(back.colors, c.colors);
@@ -339,7 +381,11 @@ fn e57_round_trip() {
         .collect();
     assert_eq!(back.attribute("intensity").unwrap().values, want);
     assert_eq!(r.dropped_missing, 0);
-    assert!(r.notes.iter().any(|n| n.starts_with("1 scan")), "{:?}", r.notes);
+    assert!(
+        r.notes.iter().any(|n| n.starts_with("1 scan")),
+        "{:?}",
+        r.notes
+    );
     // The same cloud gives the same file.
     let p2 = dir.path().join("r2.e57");
     io::write(&p2, &Geometry::from_cloud(c), &WriteOptions::default()).unwrap();
@@ -361,27 +407,42 @@ fn assert_bad(path: &Path, words: &[&str]) {
 
 #[test]
 fn bad_pcd_points_larger_than_data() {
-    assert_bad(&bad("pcd-points-larger-than-data.pcd"), &["POINTS 1000", "truncated"]);
+    assert_bad(
+        &bad("pcd-points-larger-than-data.pcd"),
+        &["POINTS 1000", "truncated"],
+    );
 }
 
 #[test]
 fn bad_pcd_truncated_compressed() {
-    assert_bad(&bad("pcd-truncated-compressed.pcd"), &["truncated binary_compressed"]);
+    assert_bad(
+        &bad("pcd-truncated-compressed.pcd"),
+        &["truncated binary_compressed"],
+    );
 }
 
 #[test]
 fn bad_pcd_unknown_data_kind() {
-    assert_bad(&bad("pcd-unknown-data-kind.pcd"), &["unknown data kind", "binary_lzma"]);
+    assert_bad(
+        &bad("pcd-unknown-data-kind.pcd"),
+        &["unknown data kind", "binary_lzma"],
+    );
 }
 
 #[test]
 fn bad_pcd_fields_size_mismatch() {
-    assert_bad(&bad("pcd-fields-size-mismatch.pcd"), &["line 4 (SIZE)", "mismatched"]);
+    assert_bad(
+        &bad("pcd-fields-size-mismatch.pcd"),
+        &["line 4 (SIZE)", "mismatched"],
+    );
 }
 
 #[test]
 fn bad_pcd_non_numeric_ascii() {
-    assert_bad(&bad("pcd-non-numeric-ascii.pcd"), &["point 1", "non-numeric", "\"abc\""]);
+    assert_bad(
+        &bad("pcd-non-numeric-ascii.pcd"),
+        &["point 1", "non-numeric", "\"abc\""],
+    );
 }
 
 #[cfg(feature = "las")]
@@ -420,6 +481,59 @@ fn truncated_files_fail_cleanly() {
                 .err()
                 .unwrap_or_else(|| panic!("{name} cut to {len} bytes was accepted"));
             assert!(err.to_string().contains("cut-"), "{err}");
+        }
+    }
+}
+
+/// Bytes overwritten at many places (header and data, all three PCD data kinds): reading may
+/// succeed or fail, but never panics.
+#[test]
+fn corrupted_pcds_never_panic() {
+    let dir = common::tempdir();
+    let c = sample_cloud(300, 0.0);
+    let mut files = Vec::new();
+    for ascii in [false, true] {
+        let p = dir.path().join(format!("k{ascii}.pcd"));
+        io::write(
+            &p,
+            &Geometry::from_cloud(c.clone()),
+            &WriteOptions { ascii },
+        )
+        .unwrap();
+        files.push(std::fs::read(&p).unwrap());
+    }
+    let p = dir.path().join("kc.pcd");
+    let pts: Vec<[f32; 3]> = (0..300).map(|i| [i as f32, 0.5, -1.0]).collect();
+    write_compressed(&p, &pts, &[7u32; 300], &[3u16; 300], 20, 15);
+    files.push(std::fs::read(&p).unwrap());
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let cut = dir.path().join("mut.pcd");
+    for full in &files {
+        for _ in 0..150 {
+            let mut f = full.clone();
+            for _ in 0..1 + next() % 4 {
+                // Half the hits in the header, where counts and sizes live.
+                let at = if next() % 2 == 0 {
+                    next() as usize % 300
+                } else {
+                    next() as usize
+                };
+                let at = at % f.len();
+                f[at] = match next() % 4 {
+                    0 => b'9',
+                    1 => 0xff,
+                    2 => b' ',
+                    _ => next() as u8,
+                };
+            }
+            std::fs::write(&cut, &f).unwrap();
+            let _ = io::read(&cut, &ReadOptions::default());
         }
     }
 }

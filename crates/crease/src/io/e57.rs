@@ -34,7 +34,10 @@ fn e57_err(path: &Path, what: &str, e: e57::Error) -> Error {
 pub fn read(path: &Path) -> Result<(Geometry, ReadReport)> {
     // The decoder is a third-party crate: a panic inside it on a corrupt file becomes an error.
     catch_unwind(AssertUnwindSafe(|| read_inner(path))).unwrap_or_else(|_| {
-        Err(Error::format(path, "the E57 decoder failed on corrupt data"))
+        Err(Error::format(
+            path,
+            "the E57 decoder failed on corrupt data",
+        ))
     })
 }
 
@@ -106,17 +109,17 @@ fn read_inner(path: &Path) -> Result<(Geometry, ReadReport)> {
     let mut cloud = PointCloud::from_positions(positions);
     if any_color {
         if missing_color > 0 {
-            report
-                .notes
-                .push(format!("{missing_color} points without colour set to black"));
+            report.notes.push(format!(
+                "{missing_color} points without colour set to black"
+            ));
         }
         cloud.set_colors(colors)?;
     }
     if any_intensity {
         if missing_intensity > 0 {
-            report
-                .notes
-                .push(format!("{missing_intensity} points without intensity set to 0"));
+            report.notes.push(format!(
+                "{missing_intensity} points without intensity set to 0"
+            ));
         }
         cloud.set_attribute(Attribute {
             name: "intensity".into(),

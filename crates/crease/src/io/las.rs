@@ -62,11 +62,16 @@ fn read_inner(path: &Path) -> Result<(Geometry, ReadReport)> {
     // The raw header gives the point data offset and record length for the size check.
     let raw = {
         let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-        las::raw::Header::read_from(std::io::BufReader::new(f))
-            .map_err(|e| las_err(path, "not a readable LAS header (the file is truncated or not LAS)", e))?
+        las::raw::Header::read_from(std::io::BufReader::new(f)).map_err(|e| {
+            las_err(
+                path,
+                "not a readable LAS header (the file is truncated or not LAS)",
+                e,
+            )
+        })?
     };
-    let mut reader = Reader::from_path(path)
-        .map_err(|e| las_err(path, "cannot open the LAS/LAZ file", e))?;
+    let mut reader =
+        Reader::from_path(path).map_err(|e| las_err(path, "cannot open the LAS/LAZ file", e))?;
     let header = reader.header().clone();
     let format = *header.point_format();
     let n = header.number_of_points();
@@ -105,12 +110,7 @@ fn read_inner(path: &Path) -> Result<(Geometry, ReadReport)> {
         if got == 0 {
             break;
         }
-        positions.extend(
-            pd.x()
-                .zip(pd.y())
-                .zip(pd.z())
-                .map(|((x, y), z)| [x, y, z]),
-        );
+        positions.extend(pd.x().zip(pd.y()).zip(pd.z()).map(|((x, y), z)| [x, y, z]));
         intensity.extend(pd.intensity().map(f64::from));
         if format.is_extended {
             // Code 12 (overlap) is a flag in the extended formats: an unclassified overlap
@@ -184,7 +184,9 @@ fn read_inner(path: &Path) -> Result<(Geometry, ReadReport)> {
         cloud.set_attribute(attr("gps_time", ScalarKind::F64, gps))?;
     }
     if count < n as usize {
-        report.notes.push(format!("{n} points announced, {count} read"));
+        report
+            .notes
+            .push(format!("{n} points announced, {count} read"));
     }
     Ok((Geometry::from_cloud(cloud), report))
 }
@@ -249,8 +251,7 @@ pub fn write(path: &Path, geom: &Geometry, _opts: &WriteOptions) -> Result<()> {
         (false, true, true) => 3,
     };
     let mut b = Builder::from(if extended { (1, 4) } else { (1, 2) });
-    b.point_format =
-        las::point::Format::new(fmt).map_err(|e| las_err(path, "point format", e))?;
+    b.point_format = las::point::Format::new(fmt).map_err(|e| las_err(path, "point format", e))?;
     b.generating_software = "crease".into();
     b.transforms = Vector {
         x: Transform {

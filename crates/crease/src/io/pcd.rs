@@ -300,13 +300,15 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
                     "ascii" => DataKind::Ascii,
                     "binary" => DataKind::Binary,
                     "binary_compressed" => DataKind::BinaryCompressed,
-                    other => return Err(Error::format(
-                        path,
-                        format!(
+                    other => {
+                        return Err(Error::format(
+                            path,
+                            format!(
                             "header line {line_no} (DATA): unknown data kind {other:?}; expected \
                                  ascii, binary or binary_compressed"
                         ),
-                    )),
+                        ))
+                    }
                 };
                 break (kind, line_no);
             }
@@ -685,7 +687,7 @@ fn read_from_bytes(path: &Path, bytes: &[u8]) -> Result<(Geometry, ReadReport)> 
         }
         DataKind::Binary => {
             let data = bytes.get(h.data_start..).unwrap_or_default();
-            let need = h.points.checked_mul(record).unwrap_or(usize::MAX);
+            let need = h.points.saturating_mul(record);
             if need > data.len() {
                 return Err(Error::format(
                     path,
@@ -760,7 +762,7 @@ fn decompress(path: &Path, bytes: &[u8], h: &Header, record: usize) -> Result<Ve
     };
     let compressed = u32::from_le_bytes(arr(cs)) as usize;
     let uncompressed = u32::from_le_bytes(arr(us)) as usize;
-    let need = h.points.checked_mul(record).unwrap_or(usize::MAX);
+    let need = h.points.saturating_mul(record);
     if uncompressed != need {
         return Err(Error::format(
             path,
