@@ -33,7 +33,7 @@ impl KdIndex {
             .nearest_n::<SquaredEuclidean<f64>>(k)
             .execute()
             .into_iter()
-            .map(|it| (it.item as u32, it.distance))
+            .map(|it| (it.item, it.distance))
             .collect();
         r.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
         r
