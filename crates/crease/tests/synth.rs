@@ -826,3 +826,29 @@ fn mesh_noise_and_open_primitives() {
         noisy.mesh.vertices.attribute("gt_edge_distance")
     );
 }
+
+/// Timing of 1M points per shape: `cargo test --release --test synth -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn timing_one_million_points() {
+    for &name in Shape::names() {
+        let shape = Shape::from_name(name).unwrap();
+        let t = std::time::Instant::now();
+        let part = sample_points(
+            &shape,
+            &SampleParams {
+                n: 1_000_000,
+                noise: Noise::AlongNormal(0.02),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let sharp = attr(&part, "gt_sharp").iter().filter(|&&v| v != 0.0).count();
+        eprintln!(
+            "{name:>20}: {:.3} s ({} surfaces, {} curves, {sharp} sharp points)",
+            t.elapsed().as_secs_f64(),
+            part.surfaces.len(),
+            part.curves.len()
+        );
+    }
+}

@@ -476,10 +476,11 @@ fn build(
 
 #[inline]
 fn box_distance(p: Point3, n: &Node) -> f64 {
-    let mut s = 0.0;
-    for k in 0..3 {
-        let d = (n.lo[k] - p[k]).max(p[k] - n.hi[k]).max(0.0);
-        s += d * d;
-    }
+    let s: f64 = (0..3)
+        .map(|k| {
+            let d = (n.lo[k] - p[k]).max(p[k] - n.hi[k]).max(0.0);
+            d * d
+        })
+        .sum();
     s.sqrt()
 }
