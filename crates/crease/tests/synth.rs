@@ -843,7 +843,10 @@ fn timing_one_million_points() {
             },
         )
         .unwrap();
-        let sharp = attr(&part, "gt_sharp").iter().filter(|&&v| v != 0.0).count();
+        let sharp = attr(&part, "gt_sharp")
+            .iter()
+            .filter(|&&v| v != 0.0)
+            .count();
         eprintln!(
             "{name:>20}: {:.3} s ({} surfaces, {} curves, {sharp} sharp points)",
             t.elapsed().as_secs_f64(),
