@@ -73,7 +73,7 @@ pub fn run(g: &Global, a: &RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The polylines and edges of `geom` as drawable polylines. Curves tagged by a `kind` edge
+/// The polylines and edges of `geom` as drawable polylines. Curves tagged by a `curve_kind` edge
 /// attribute (0 sharp, 1 smooth, 2 boundary, as `crease synth` writes them) get their colours.
 pub fn polylines_of(geom: &crease::io::Geometry, file_index: usize) -> Vec<Polyline> {
     let pts = &geom.points.positions;
@@ -89,7 +89,7 @@ pub fn polylines_of(geom: &crease::io::Geometry, file_index: usize) -> Vec<Polyl
             label: None,
         });
     }
-    let kind = geom.edge_attributes.get("kind");
+    let kind = geom.edge_attributes.get("curve_kind");
     for (i, e) in geom.edges.iter().enumerate() {
         let (color, label) = match kind.map(|k| k.values[i] as i64) {
             Some(0) => ([220, 30, 30], Some("sharp")),
