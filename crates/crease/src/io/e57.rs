@@ -26,7 +26,6 @@ use super::{Geometry, ReadReport, WriteOptions};
 use crate::geometry::{Attribute, PointCloud, ScalarKind};
 use crate::{Error, Result};
 
-<<<<<<< HEAD
 fn e57_err(path: &Path, what: &str, e: e57::Error) -> Error {
     Error::format(path, format!("{what}: {e}"))
 }
@@ -216,20 +215,4 @@ pub fn write(path: &Path, geom: &Geometry, _opts: &WriteOptions) -> Result<()> {
     w.finalize()
         .map_err(|e| e57_err(path, "cannot finish the file", e))?;
     Ok(())
-=======
-/// Reads a e57 file.
-pub fn read(path: &Path) -> Result<(Geometry, ReadReport)> {
-    Err(Error::Unsupported {
-        path: path.to_path_buf(),
-        message: "not yet".into(),
-    })
-}
-
-/// Writes a e57 file.
-pub fn write(path: &Path, _geom: &Geometry, _opts: &WriteOptions) -> Result<()> {
-    Err(Error::Unsupported {
-        path: path.to_path_buf(),
-        message: "not yet".into(),
-    })
->>>>>>> synth
 }

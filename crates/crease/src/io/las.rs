@@ -37,7 +37,6 @@ use super::{Geometry, ReadReport, WriteOptions};
 use crate::geometry::{Attribute, PointCloud, ScalarKind};
 use crate::{Error, Result};
 
-<<<<<<< HEAD
 /// Points decoded per batch.
 const BATCH: u64 = 1 << 16;
 
@@ -333,20 +332,4 @@ mod tests {
             assert!(s * 10.0 > 2e-6 * d, "d {d} s {s}");
         }
     }
-=======
-/// Reads a las file.
-pub fn read(path: &Path) -> Result<(Geometry, ReadReport)> {
-    Err(Error::Unsupported {
-        path: path.to_path_buf(),
-        message: "not yet".into(),
-    })
-}
-
-/// Writes a las file.
-pub fn write(path: &Path, _geom: &Geometry, _opts: &WriteOptions) -> Result<()> {
-    Err(Error::Unsupported {
-        path: path.to_path_buf(),
-        message: "not yet".into(),
-    })
->>>>>>> synth
 }

@@ -42,7 +42,6 @@ use super::{Geometry, ReadReport, WriteOptions};
 use crate::geometry::{Attribute, PointCloud, ScalarKind};
 use crate::{Error, Result};
 
-<<<<<<< HEAD
 /// Largest COUNT for which a field is expanded into `name_0 ..` attributes.
 const MAX_EXPANDED_COUNT: usize = 64;
 
@@ -1187,20 +1186,4 @@ mod tests {
         let t = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 4000000000000000000\nPOINTS 5\nDATA binary\n";
         assert!(parse(t).is_err());
     }
-=======
-/// Reads a pcd file.
-pub fn read(path: &Path) -> Result<(Geometry, ReadReport)> {
-    Err(Error::Unsupported {
-        path: path.to_path_buf(),
-        message: "not yet".into(),
-    })
-}
-
-/// Writes a pcd file.
-pub fn write(path: &Path, _geom: &Geometry, _opts: &WriteOptions) -> Result<()> {
-    Err(Error::Unsupported {
-        path: path.to_path_buf(),
-        message: "not yet".into(),
-    })
->>>>>>> synth
 }
