@@ -302,7 +302,19 @@ impl Parser {
     ) -> std::result::Result<(u32, u32), String> {
         let mut parts = tok.split(|&b| b == b'/');
         let vpart = parts.next().unwrap_or(b"");
-        let _vt = parts.next();
+        if let Some(vt) = parts.next().filter(|p| !p.is_empty()) {
+            let ok = std::str::from_utf8(vt)
+                .ok()
+                .and_then(|s| s.parse::<i64>().ok())
+                .is_some_and(|i| i != 0);
+            if !ok {
+                return Err(format!(
+                    "expected a texture index in {what} corner '{}', found '{}'",
+                    lossy(tok),
+                    lossy(vt)
+                ));
+            }
+        }
         let npart = parts.next().filter(|p| !p.is_empty());
         if parts.next().is_some() {
             return Err(format!(
@@ -311,10 +323,8 @@ impl Parser {
             ));
         }
         let v = resolve(vpart, self.positions.len(), "vertex", what, tok)?;
-        if v.1 {
-            if self.max_v.is_none_or(|(m, _, _)| v.0 > m) {
-                self.max_v = Some((v.0, ln, what));
-            }
+        if v.1 && self.max_v.is_none_or(|(m, _, _)| v.0 > m) {
+            self.max_v = Some((v.0, ln, what));
         }
         let n = match npart {
             Some(np) => {
@@ -438,8 +448,7 @@ impl Parser {
                     let slot = &mut self.vertex_normal[v as usize];
                     if *slot == NONE {
                         *slot = n;
-                    } else if *slot != n
-                        && self.normals[*slot as usize] != self.normals[n as usize]
+                    } else if *slot != n && self.normals[*slot as usize] != self.normals[n as usize]
                     {
                         conflict[v as usize] = true;
                     }

@@ -126,10 +126,15 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Geometry, ReadReport)>
             }
         };
         let rest: Vec<&[u8]> = htoks.collect();
-        if rest.first().is_some_and(|t| t.eq_ignore_ascii_case(b"BINARY")) {
+        if rest
+            .first()
+            .is_some_and(|t| t.eq_ignore_ascii_case(b"BINARY"))
+        {
             return Err(Error::Unsupported {
                 path: path.to_path_buf(),
-                message: format!("line {hl}: binary OFF is not supported; convert it to text OFF or PLY"),
+                message: format!(
+                    "line {hl}: binary OFF is not supported; convert it to text OFF or PLY"
+                ),
             });
         }
         (st, color, normal) = (st_, c_, n_);
@@ -339,12 +344,7 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Geometry, ReadReport)>
     }
     if color {
         let scale = if float_colors { 255.0 } else { 1.0 };
-        cloud.colors = Some(
-            colors
-                .iter()
-                .map(|c| c.map(|v| to_u8(v * scale)))
-                .collect(),
-        );
+        cloud.colors = Some(colors.iter().map(|c| c.map(|v| to_u8(v * scale))).collect());
     }
     if st {
         report.notes.push("texture coordinates ignored".into());

@@ -226,11 +226,11 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Geometry, ReadReport)>
             if let (Some(r), Some(g), Some(b)) = (r, g, b) {
                 color_cols = Some([r, g, b]);
             }
-            for j in 3..ncols {
+            for (j, raw) in names.iter().enumerate().skip(3) {
                 let used = normal_cols.is_some_and(|c| c.contains(&j))
                     || color_cols.is_some_and(|c| c.contains(&j));
                 if !used {
-                    let name = names[j].trim();
+                    let name = raw.trim();
                     let taken = name.is_empty()
                         || attrs.iter().any(|(_, a)| a == name)
                         || ["x", "y", "z"].contains(&name);
@@ -278,13 +278,12 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Geometry, ReadReport)>
         roles.extend(["nx", "ny", "nz"].map(String::from));
     }
     if let Some([a, b, c]) = color_cols {
-        let unit = values.par_chunks_exact(ncols).all(|r| {
-            [r[a], r[b], r[c]]
-                .iter()
-                .all(|v| (0.0..=1.0).contains(v))
-        }) && values
+        let unit = values
             .par_chunks_exact(ncols)
-            .any(|r| [r[a], r[b], r[c]].iter().any(|v| v.fract() != 0.0));
+            .all(|r| [r[a], r[b], r[c]].iter().all(|v| (0.0..=1.0).contains(v)))
+            && values
+                .par_chunks_exact(ncols)
+                .any(|r| [r[a], r[b], r[c]].iter().any(|v| v.fract() != 0.0));
         let scale = if unit { 255.0 } else { 1.0 };
         let colors: Vec<[u8; 3]> = values
             .par_chunks_exact(ncols)
@@ -342,7 +341,11 @@ fn parse_rows(
                         None => {
                             return Err((
                                 line,
-                                format!("column {}: expected a number, found '{}'", k + 1, lossy(f)),
+                                format!(
+                                    "column {}: expected a number, found '{}'",
+                                    k + 1,
+                                    lossy(f)
+                                ),
                             ))
                         }
                     }
@@ -408,7 +411,8 @@ fn split_fields(t: &[u8]) -> impl Iterator<Item = &[u8]> {
 
 /// Whitespace-separated tokens.
 pub(super) fn tokens(t: &[u8]) -> impl Iterator<Item = &[u8]> {
-    t.split(|b| b.is_ascii_whitespace()).filter(|f| !f.is_empty())
+    t.split(|b| b.is_ascii_whitespace())
+        .filter(|f| !f.is_empty())
 }
 
 /// Parses a decimal number (also `nan`, `inf`).
