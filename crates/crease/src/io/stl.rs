@@ -27,6 +27,8 @@
 //! [`WriteOptions::ascii`] (coordinates exact). Facet normals are computed from the corners.
 //! A geometry without triangles is refused.
 
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hash, Hasher};
 use std::io::Write;
 use std::path::Path;
 
@@ -212,18 +214,17 @@ fn starts_with_solid(bytes: &[u8]) -> bool {
 /// The corners of the first `n` triangles of a binary STL whose size was checked to hold them.
 fn binary_corners(bytes: &[u8], n: usize) -> Vec<[f64; 3]> {
     let body = bytes.get(84..84 + 50 * n).unwrap_or(&[]);
-    let per_tri: Vec<[[f64; 3]; 3]> = body
-        .par_chunks_exact(50)
-        .map(|r| {
+    let mut corners = vec![[0.0f64; 3]; 3 * n];
+    corners
+        .par_chunks_mut(3)
+        .zip(body.par_chunks_exact(50))
+        .for_each(|(out, r)| {
             let f = |o: usize| f64::from(f32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]]));
-            [
-                [f(12), f(16), f(20)],
-                [f(24), f(28), f(32)],
-                [f(36), f(40), f(44)],
-            ]
-        })
-        .collect();
-    per_tri.into_iter().flatten().collect()
+            out[0] = [f(12), f(16), f(20)];
+            out[1] = [f(24), f(28), f(32)];
+            out[2] = [f(36), f(40), f(44)];
+        });
+    corners
 }
 
 /// The corners of an ASCII STL (fan-triangulating loops of more than 3 vertices).
@@ -365,38 +366,56 @@ fn ascii_corners(path: &Path, bytes: &[u8], report: &mut ReadReport) -> Result<V
     Ok(corners)
 }
 
-/// Merges corners with identical coordinates. Returns the vertices (in order of first
-/// appearance) and one triangle per three corners.
+/// Merges corners with identical coordinates (bit patterns, `-0.0` folded into `0.0`).
+/// Returns the vertices in order of first appearance and one triangle per three corners.
 fn merge_corners(corners: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let key = |i: u32| -> [u64; 3] {
-        corners[i as usize].map(|c| if c == 0.0 { 0u64 } else { c.to_bits() })
-    };
-    let mut order: Vec<u32> = (0..corners.len() as u32).collect();
-    order.par_sort_unstable_by_key(|&i| (key(i), i));
-    // rep[c] = the first corner with c's coordinates.
-    let mut rep = vec![0u32; corners.len()];
-    let mut g = 0;
-    while g < order.len() {
-        let k = key(order[g]);
-        let first = order[g];
-        let mut e = g;
-        while e < order.len() && key(order[e]) == k {
-            rep[order[e] as usize] = first;
-            e += 1;
+    let mut index: HashMap<Key, u32, BuildHasherDefault<Mix>> =
+        HashMap::with_capacity_and_hasher(corners.len() / 6 + 16, Default::default());
+    let mut positions = Vec::with_capacity(corners.len() / 6 + 16);
+    let mut ids = Vec::with_capacity(corners.len());
+    for c in corners {
+        let key = Key(c.map(|x| if x == 0.0 { 0 } else { x.to_bits() }));
+        let next = positions.len() as u32;
+        let id = *index.entry(key).or_insert(next);
+        if id == next {
+            positions.push(*c);
         }
-        g = e;
+        ids.push(id);
     }
-    let mut id = vec![0u32; corners.len()];
-    let mut positions = Vec::new();
-    for c in 0..corners.len() {
-        let r = rep[c] as usize;
-        if r == c {
-            id[c] = positions.len() as u32;
-            positions.push(corners[c]);
-        } else {
-            id[c] = id[r];
-        }
-    }
-    let faces = id.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let faces = ids.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
     (positions, faces)
+}
+
+/// A corner's coordinates as bit patterns, hashed as three words.
+#[derive(PartialEq, Eq)]
+struct Key([u64; 3]);
+
+impl Hash for Key {
+    fn hash<H: Hasher>(&self, h: &mut H) {
+        for w in self.0 {
+            h.write_u64(w);
+        }
+    }
+}
+
+/// A small fast hasher for [`Key`]: multiply-rotate mixing, splitmix64 finaliser (so that keys
+/// differing only in exponent bits still spread over the table).
+#[derive(Default)]
+struct Mix(u64);
+
+impl Hasher for Mix {
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.write_u64(u64::from(*b));
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(23) ^ x).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
+    fn finish(&self) -> u64 {
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
 }
