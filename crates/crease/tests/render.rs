@@ -789,3 +789,182 @@ fn demo_image() {
     render_png(&scene, &params, &path).unwrap();
     eprintln!("wrote {}", path.display());
 }
+
+/// Render times at 100k and 1M points (four views, coloured by a flag, with the cube's
+/// edges): `cargo test --release -p crease --test render -- --ignored timing --nocapture`.
+#[test]
+#[ignore]
+fn timing() {
+    for n in [129, 408] {
+        let cloud = cube_points(n, 0.05);
+        let scene = Scene {
+            points: Some(&cloud),
+            polylines: cube_edges(crease::render::SMOOTH_LINE, "edge"),
+            ..Default::default()
+        };
+        let params = RenderParams {
+            color_by: ColorBy::Attribute("sharp".into()),
+            ..Default::default()
+        };
+        let _ = render(&scene, &params).unwrap();
+        let t = std::time::Instant::now();
+        let reps = 3;
+        for _ in 0..reps {
+            let _ = render(&scene, &params).unwrap();
+        }
+        let dt = t.elapsed().as_secs_f64() / f64::from(reps);
+        let t = std::time::Instant::now();
+        let img = render(&scene, &params).unwrap();
+        let _png = img.encode_png().unwrap();
+        let dt_png = t.elapsed().as_secs_f64();
+        eprintln!(
+            "{} points: render {:.3} s, render + PNG encode {:.3} s ({} threads)",
+            cloud.len(),
+            dt,
+            dt_png,
+            rayon::current_num_threads()
+        );
+    }
+}
+
+/// Reads the shared-data OFF mesh (demo only; the library's reader lives in `io`).
+fn read_off(path: &std::path::Path) -> TriMesh {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut it = text.split_whitespace();
+    assert_eq!(it.next(), Some("OFF"));
+    let nv: usize = it.next().unwrap().parse().unwrap();
+    let nf: usize = it.next().unwrap().parse().unwrap();
+    let _ne = it.next();
+    let mut num = || -> f64 { it.next().unwrap().parse().unwrap() };
+    let v: Vec<[f64; 3]> = (0..nv).map(|_| [num(), num(), num()]).collect();
+    let mut f = Vec::new();
+    for _ in 0..nf {
+        let k = num() as usize;
+        let ids: Vec<u32> = (0..k).map(|_| num() as u32).collect();
+        for j in 1..k - 1 {
+            f.push([ids[0], ids[j], ids[j + 1]]);
+        }
+    }
+    TriMesh::new(v, f).unwrap()
+}
+
+/// Reads a PCEDNet PLY (x y z nx ny nz as float, r g b a as uchar): the cloud with normals
+/// and a `gt_sharp` flag from the class colour (demo only).
+fn read_pcednet(path: &std::path::Path) -> PointCloud {
+    let bytes = std::fs::read(path).unwrap();
+    let end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    let header = String::from_utf8_lossy(&bytes[..end]);
+    let n: usize = header
+        .lines()
+        .find_map(|l| l.strip_prefix("element vertex "))
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    let mut pos = Vec::with_capacity(n);
+    let mut nor = Vec::with_capacity(n);
+    let mut sharp = Vec::with_capacity(n);
+    for i in 0..n {
+        let r = &bytes[end + 28 * i..end + 28 * (i + 1)];
+        let f = |k: usize| {
+            f64::from(f32::from_le_bytes([
+                r[4 * k],
+                r[4 * k + 1],
+                r[4 * k + 2],
+                r[4 * k + 3],
+            ]))
+        };
+        pos.push([f(0), f(1), f(2)]);
+        nor.push([f(3), f(4), f(5)]);
+        sharp.push(r[24] > 0 && r[25] == 0 && r[26] == 0);
+    }
+    let mut c = PointCloud::from_positions(pos);
+    c.set_normals(nor).unwrap();
+    c.set_attribute(Attribute::flag("gt_sharp", sharp)).unwrap();
+    c
+}
+
+/// Sample images from the shared data, for eyeballing:
+/// `cargo test -p crease --test render -- --ignored demo_real`.
+#[test]
+#[ignore]
+fn demo_real_data() {
+    let Some(dir) = common::data_dir() else {
+        return;
+    };
+    // Fandisk: shaded mesh and its edges with a dihedral angle above 30 degrees.
+    let mesh = read_off(&dir.join("meshes/fandisk.off"));
+    let mut edges: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (fi, f) in mesh.faces.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            edges.entry((a.min(b), a.max(b))).or_default().push(fi);
+        }
+    }
+    let normal = |fi: usize| {
+        let [a, b, c] = mesh.triangle(fi);
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        [n[0] / l, n[1] / l, n[2] / l]
+    };
+    let mut keys: Vec<_> = edges.keys().copied().collect();
+    keys.sort();
+    let mut lines = Vec::new();
+    for (a, b) in keys {
+        let fs = &edges[&(a, b)];
+        if fs.len() == 2 {
+            let (n0, n1) = (normal(fs[0]), normal(fs[1]));
+            let c = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2];
+            if c < 30f64.to_radians().cos() {
+                lines.push(Polyline {
+                    points: vec![mesh.positions()[a as usize], mesh.positions()[b as usize]],
+                    closed: false,
+                    color: crease::render::SHARP_LINE,
+                    label: Some("sharp edge".into()),
+                });
+            }
+        }
+    }
+    let scene = Scene {
+        mesh: Some(&mesh),
+        polylines: lines,
+        ..Default::default()
+    };
+    let params = RenderParams {
+        title: Some("fandisk: dihedral angle > 30 deg".into()),
+        ..Default::default()
+    };
+    let out = std::env::temp_dir().join("crease-render-fandisk.png");
+    render_png(&scene, &params, &out).unwrap();
+    eprintln!("wrote {}", out.display());
+    // A PCEDNet ABC cloud coloured by its ground-truth sharp flag, and lit (uniform).
+    let cloud = read_pcednet(&dir.join("points-gt/abc/0133.ply"));
+    let scene = Scene {
+        points: Some(&cloud),
+        ..Default::default()
+    };
+    for (name, color_by) in [
+        ("gt", ColorBy::Attribute("gt_sharp".into())),
+        ("lit", ColorBy::Uniform),
+        ("normal", ColorBy::Normal),
+    ] {
+        let params = RenderParams {
+            title: Some(format!("ABC 0133 ({name})")),
+            color_by,
+            ..Default::default()
+        };
+        let out = std::env::temp_dir().join(format!("crease-render-abc-{name}.png"));
+        render_png(&scene, &params, &out).unwrap();
+        eprintln!("wrote {}", out.display());
+    }
+}

@@ -113,8 +113,8 @@ pub fn hashed_color(v: i64) -> [u8; 3] {
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^= z >> 31;
     let hue = (z & 0xFFFF) as f64 / 65536.0;
-    let sat = 0.55 + 0.4 * ((z >> 16) & 0xFF) as f64 / 255.0;
-    let light = 0.38 + 0.24 * ((z >> 24) & 0xFF) as f64 / 255.0;
+    let sat = 0.45 + 0.3 * ((z >> 16) & 0xFF) as f64 / 255.0;
+    let light = 0.42 + 0.2 * ((z >> 24) & 0xFF) as f64 / 255.0;
     hsl(hue, sat, light)
 }
 

@@ -48,13 +48,14 @@
 //! assert_eq!((image.width(), image.height()), (800, 600));
 //! ```
 
-pub mod camera;
+mod camera;
 pub mod colormap;
 pub mod font;
 mod legend;
 mod raster;
 mod style;
 
+use std::io::Write;
 use std::path::Path;
 
 use rayon::prelude::*;
@@ -184,9 +185,9 @@ const MIN_SIDE: u32 = 32;
 /// Largest image side accepted.
 const MAX_SIDE: u32 = 16384;
 /// Ambient light.
-const AMBIENT: f32 = 0.32;
+const AMBIENT: f32 = 0.38;
 /// Diffuse light.
-const DIFFUSE: f32 = 0.68;
+const DIFFUSE: f32 = 0.62;
 /// Opacity factor of polyline parts hidden behind the surface.
 const HIDDEN_ALPHA: f32 = 0.25;
 
@@ -243,9 +244,9 @@ const DENSITY_CELL: f32 = 16.0;
 /// Automatic point diameter for one view: the points are binned into 16-pixel cells; in each
 /// cell only the points within three cells' depth of the nearest one count (the visible
 /// layer, not the far side of a closed surface). With `k` the median count over occupied
-/// cells, the on-screen spacing is `16 / sqrt(k)` px and the diameter 1.5 times that (enough
-/// to close the gaps of a regular or moderately irregular sampling), clamped to
-/// [1, `max_d`].
+/// cells, the on-screen spacing is `s = 16 / sqrt(k)` px and the diameter `1.5 s + 1` (enough
+/// to close the gaps of a regular or moderately irregular sampling once disc centres are
+/// snapped to pixels), clamped to [1, `max_d`].
 fn auto_point_size(points: &[Point3], cam: &Camera, w: u32, h: u32, max_d: f32) -> f32 {
     let gw = (w as f32 / DENSITY_CELL).ceil().max(1.0) as usize;
     let gh = (h as f32 / DENSITY_CELL).ceil().max(1.0) as usize;
@@ -284,7 +285,7 @@ fn auto_point_size(points: &[Point3], cam: &Camera, w: u32, h: u32, max_d: f32) 
     let mid = occupied.len() / 2;
     let (_, k, _) = occupied.select_nth_unstable(mid);
     let spacing = DENSITY_CELL / (*k as f32).sqrt();
-    (1.5 * spacing).clamp(1.0, max_d)
+    (1.5 * spacing + 1.0).clamp(1.0, max_d)
 }
 
 /// Draws one view: mesh, then points, then polylines.
@@ -607,10 +608,36 @@ pub fn render(scene: &Scene, params: &RenderParams) -> Result<tiny_skia::Pixmap>
         let cx = cell.x + 1;
         let cy = cell.y + label_h;
         if content_w >= 120 && content_h >= 90 {
+            // The triad goes in the corner of the view least covered by the drawing (bottom
+            // left when free), behind the geometry.
             let len = (14 * ts + 4) as f32;
-            let ox = (cx + pad) as f32 + len + 2.0;
-            let oy = (cy + i64::from(content_h) - pad) as f32 - len - 2.0;
-            draw_triad(&mut canvas, cam, ox, oy, len, ts);
+            let inset = pad as f32 + len + 2.0;
+            let reach = (len + (font::CAP_H * ts) as f32 * 1.5 + 2.0).ceil() as i64;
+            let (fw, fh) = (content_w as f32, content_h as f32);
+            let corners = [
+                (inset, fh - inset),
+                (fw - inset, fh - inset),
+                (fw - inset, inset),
+                (inset, inset),
+            ];
+            let mut best = corners[0];
+            let mut best_n = usize::MAX;
+            for c in corners {
+                let (x, y) = (c.0.round() as i64, c.1.round() as i64);
+                let n = vb.drawn_in(x - reach, y - reach, x + reach, y + reach);
+                if n < best_n {
+                    best_n = n;
+                    best = c;
+                }
+            }
+            draw_triad(
+                &mut canvas,
+                cam,
+                cx as f32 + best.0,
+                cy as f32 + best.1,
+                len,
+                ts,
+            );
         }
         vb.composite(&mut canvas, cx, cy);
     }
@@ -633,5 +660,8 @@ pub fn render_png(scene: &Scene, params: &RenderParams, path: &Path) -> Result<(
     let bytes = pixmap
         .encode_png()
         .map_err(|e| Error::format(path, format!("cannot encode PNG: {e}")))?;
-    std::fs::write(path, bytes).map_err(|e| Error::io(path, e))
+    let mut out = crate::io::create(path)?;
+    out.write_all(&bytes)
+        .and_then(|()| out.flush())
+        .map_err(|e| Error::io(path, e))
 }

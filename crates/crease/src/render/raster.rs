@@ -356,6 +356,23 @@ impl ViewBuffer {
         });
     }
 
+    /// Number of pixels in the rectangle [x0, x1] × [y0, y1] (clipped) where something was
+    /// drawn.
+    pub fn drawn_in(&self, x0: i64, y0: i64, x1: i64, y1: i64) -> usize {
+        let mut n = 0;
+        for y in y0.max(0)..=y1.min(i64::from(self.h) - 1) {
+            for x in x0.max(0)..=x1.min(i64::from(self.w) - 1) {
+                let i = y as usize * self.w as usize + x as usize;
+                let d = self.depth.get(i).copied().unwrap_or(f32::INFINITY);
+                let a = self.line_a.get(i).copied().unwrap_or(0.0);
+                if d.is_finite() || a > 0.0 {
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+
     /// Copies the view onto `canvas` with its top-left at (`ox`, `oy`): surface colour where
     /// something was drawn, the polyline overlay blended on top; empty pixels are left as they
     /// are (so decorations drawn beforehand stay behind the geometry).

@@ -17,7 +17,7 @@ use crate::geometry::Point3;
 use crate::{Error, Result};
 
 /// Default point colour for `ColorBy::Uniform`.
-pub(crate) const UNIFORM_POINT: [u8; 3] = [52, 101, 164];
+pub(crate) const UNIFORM_POINT: [u8; 3] = [120, 150, 192];
 /// Default mesh colour for `ColorBy::Uniform` (before lighting).
 pub(crate) const UNIFORM_MESH: [u8; 3] = [176, 190, 208];
 
