@@ -381,26 +381,19 @@ fn float_attribute_maps_min_and_max_to_viridis_ends() {
     let last = viridis(1.0);
     assert_eq!(first, [68, 1, 84]);
     assert_eq!(last, [253, 231, 37]);
-    let (fx0, fy0, fx1, fy1) = bbox_of(&img, first).expect("min-value colour");
-    let (lx0, _, lx1, _) = bbox_of(&img, last).expect("max-value colour");
-    // The colour bar (right, in the legend) also holds both ends: look left of it only.
-    let bar_left = fx1.max(lx1);
-    let _ = bar_left;
+    let (fx0, fy0, _, fy1) = bbox_of(&img, first).expect("min-value colour");
+    let (lx0, _, _, _) = bbox_of(&img, last).expect("max-value colour");
     // Min-value points (x = 0) are on the left edge of the square, max-value on the right.
     assert!(fx0 < lx0, "first colour at {fx0}, last at {lx0}");
     let ym = (fy0 + fy1) / 2;
     // Pixel column of the leftmost points: the first colour; middle: neither end.
     assert_eq!(px(&img, fx0 + 1, ym), first);
-    let red = bbox_of(&img, last).unwrap();
-    // The rightmost column of the square (not the colour bar, which is further right and
-    // starts lower than the top of the square is irrelevant): find last-colour pixels on row ym.
+    // The colour bar (in the legend, right) also holds both ends; along the middle row of the
+    // square the first last-colour pixel is the square's right edge.
     let row_last: Vec<u32> = (0..img.width())
         .filter(|&x| px(&img, x, ym) == last)
         .collect();
-    assert!(
-        !row_last.is_empty(),
-        "max colour on the middle row; bbox {red:?}"
-    );
+    assert!(!row_last.is_empty(), "max colour on the middle row");
     let row_first: Vec<u32> = (0..img.width())
         .filter(|&x| px(&img, x, ym) == first)
         .collect();
@@ -491,7 +484,7 @@ fn polyline_colour_lies_along_its_path() {
     )
     .unwrap();
     dump(&img, "9");
-    let (x0, y0, x1, y1) = bbox_of(&img, GREEN).expect("line pixels");
+    let (x0, _, x1, y1) = bbox_of(&img, GREEN).expect("line pixels");
     assert!(x1 - x0 > 500, "line spans {x0}..{x1}");
     // Walk both segments: in world x = 0 .. 2 the image x is linear, y follows the polyline.
     let sx = f64::from(x1 - x0) / 2.0;
@@ -500,7 +493,6 @@ fn polyline_colour_lies_along_its_path() {
         let y = f64::from(y1) - wy * sx;
         (x.round() as u32, y.round() as u32)
     };
-    let _ = y0;
     for k in 1..40 {
         let wx = 2.0 * f64::from(k) / 40.0;
         let wy = if wx <= 1.0 {
