@@ -246,6 +246,12 @@ fn parse_type(path: &Path, line: usize, tok: Option<&str>) -> Result<ScalarKind>
 }
 
 fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
+    if bytes.is_empty() {
+        return Err(Error::format(
+            path,
+            "the file is empty; expected a PLY header starting with the line `ply`",
+        ));
+    }
     let mut pos = 0usize;
     let mut line_no = 0usize;
     let mut format: Option<(PlyEncoding, String)> = None;
@@ -722,12 +728,13 @@ fn decode_ascii(
     want: &[bool],
 ) -> Result<Vec<Col>> {
     let remaining = bytes.len().saturating_sub(*pos);
-    // Every value takes at least one character and one separator.
+    // Every value takes at least one character and one separator (the very last value of the
+    // file may lack its newline).
     let min_row = 2 * el.props.len();
     if el
         .count
         .checked_mul(min_row)
-        .is_none_or(|need| need > remaining)
+        .is_none_or(|need| need > remaining + 1)
     {
         return Err(Error::format(
             path,
@@ -818,8 +825,15 @@ fn decode_ascii(
     }))
 }
 
-fn parse_number(tok: &[u8]) -> Option<f64> {
-    std::str::from_utf8(tok).ok()?.parse::<f64>().ok()
+/// Parses an ascii value of `kind`: a `float` is parsed as f32 (then widened), so that the
+/// value is the one a binary file would hold; every other kind as f64, which holds them exactly.
+fn parse_number(tok: &[u8], kind: ScalarKind) -> Option<f64> {
+    let s = std::str::from_utf8(tok).ok()?;
+    if kind == ScalarKind::F32 {
+        s.parse::<f32>().ok().map(f64::from)
+    } else {
+        s.parse::<f64>().ok()
+    }
 }
 
 fn parse_ascii_row(line: &[u8], el: &ElementDef, cols: &mut [Col]) -> Result<(), String> {
@@ -842,7 +856,7 @@ fn parse_ascii_row(line: &[u8], el: &ElementDef, cols: &mut [Col]) -> Result<(),
                         el.props.len()
                     ));
                 };
-                let v = parse_number(t).ok_or_else(|| {
+                let v = parse_number(t, k).ok_or_else(|| {
                     format!(
                         "property `{}`: {:?} is not a number; expected a {} value",
                         prop.name,
@@ -854,14 +868,14 @@ fn parse_ascii_row(line: &[u8], el: &ElementDef, cols: &mut [Col]) -> Result<(),
                     c.push(v);
                 }
             }
-            PropType::List { .. } => {
+            PropType::List { item, .. } => {
                 let Some(t) = toks.next() else {
                     return Err(format!(
                         "the line ends before the count of list `{}`",
                         prop.name
                     ));
                 };
-                let c = parse_number(t).ok_or_else(|| {
+                let c = parse_number(t, ScalarKind::F64).ok_or_else(|| {
                     format!(
                         "list `{}`: count {:?} is not a number; expected an integer >= 0",
                         prop.name,
@@ -884,7 +898,7 @@ fn parse_ascii_row(line: &[u8], el: &ElementDef, cols: &mut [Col]) -> Result<(),
                             prop.name
                         ));
                     };
-                    let v = parse_number(t).ok_or_else(|| {
+                    let v = parse_number(t, item).ok_or_else(|| {
                         format!(
                             "list `{}` value {i}: {:?} is not a number",
                             prop.name,
