@@ -90,8 +90,8 @@ fn rich_geometry() -> Geometry {
 fn assert_bit_exact(a: &Geometry, b: &Geometry) {
     assert_eq!(a.points.len(), b.points.len());
     for (p, q) in a.points.positions.iter().zip(&b.points.positions) {
-        for k in 0..3 {
-            assert_eq!(p[k].to_bits(), q[k].to_bits(), "{p:?} vs {q:?}");
+        for (x, y) in p.iter().zip(q) {
+            assert_eq!(x.to_bits(), y.to_bits(), "{p:?} vs {q:?}");
         }
     }
 }
@@ -256,8 +256,7 @@ fn polygons_are_fan_triangulated_with_attributes_duplicated() {
                     .replace("ascii", "binary_little_endian")
                     .into_bytes();
                 b.extend_from_slice(b"end_header\n");
-                for i in 0..6 {
-                    let p = [[0, 0], [1, 0], [1, 1], [0, 1], [2, 0], [2, 1]][i];
+                for p in [[0, 0], [1, 0], [1, 1], [0, 1], [2, 0], [2, 1]] {
                     for v in [p[0] as f32, p[1] as f32, 0.0f32] {
                         b.extend_from_slice(&v.to_le_bytes());
                     }
@@ -583,8 +582,7 @@ fn nan_coordinate_is_dropped_or_refused() {
     assert_eq!(report.dropped_faces, 1);
     assert_eq!(g.points.positions, vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
     let err = crease::io::read(&path, &ReadOptions { strict: true })
-        .err()
-        .expect("strict refuses")
+        .expect_err("strict refuses")
         .to_string();
     assert!(
         err.contains("ply-nan-coordinate.ply") && err.contains("NaN"),

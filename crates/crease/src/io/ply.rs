@@ -407,11 +407,14 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
 
 /// The decoded values of one property of an element.
 #[derive(Debug, Clone)]
-enum Col {
+enum Col<'a> {
     /// Not kept (skipped list, or an element crease does not read).
     Skipped,
     /// One value per row.
     Scalar(Vec<f64>),
+    /// A property of fixed-size binary rows, not decoded yet: the value of row `i` is at byte
+    /// `i * row_size + off` of `body`. Decoded straight into its final array when it is used.
+    Raw(RawCol<'a>),
     /// Row `i` holds `items[offsets[i]..offsets[i + 1]]`.
     List {
         offsets: Vec<usize>,
@@ -419,8 +422,37 @@ enum Col {
     },
 }
 
-impl Col {
-    fn new(want: bool, ty: PropType, rows: usize) -> Col {
+/// One property of the fixed-size rows of a binary element (see [`Col::Raw`]).
+#[derive(Debug, Clone, Copy)]
+struct RawCol<'a> {
+    body: &'a [u8],
+    row_size: usize,
+    off: usize,
+    kind: ScalarKind,
+    be: bool,
+}
+
+impl RawCol<'_> {
+    #[inline(always)]
+    fn get(&self, row: &[u8]) -> f64 {
+        read_scalar(row, self.off, self.kind, self.be).unwrap_or(0.0)
+    }
+
+    /// Decodes every row with `f` in parallel.
+    fn decode<T: Send, F: Fn(&[u8]) -> T + Sync + Send>(&self, f: F) -> Vec<T> {
+        let mut out = Vec::new();
+        if self.row_size > 0 {
+            self.body
+                .par_chunks_exact(self.row_size)
+                .map(f)
+                .collect_into_vec(&mut out);
+        }
+        out
+    }
+}
+
+impl Col<'_> {
+    fn new(want: bool, ty: PropType, rows: usize) -> Self {
         match (want, ty) {
             (false, _) => Col::Skipped,
             (true, PropType::Scalar(_)) => Col::Scalar(Vec::with_capacity(rows)),
@@ -436,7 +468,7 @@ impl Col {
     }
 
     /// Appends `other`'s rows after self's.
-    fn append(&mut self, other: Col) {
+    fn append(&mut self, other: Self) {
         match (self, other) {
             (Col::Scalar(a), Col::Scalar(b)) => a.extend_from_slice(&b),
             (
@@ -480,14 +512,14 @@ fn binary_size_error(
     )
 }
 
-fn decode_binary(
+fn decode_binary<'a>(
     path: &Path,
-    bytes: &[u8],
+    bytes: &'a [u8],
     pos: &mut usize,
     el: &ElementDef,
     want: &[bool],
     be: bool,
-) -> Result<Vec<Col>> {
+) -> Result<Vec<Col<'a>>> {
     let remaining = bytes.len().saturating_sub(*pos);
     let fixed = el.props.iter().all(|p| matches!(p.ty, PropType::Scalar(_)));
     let min_row: usize = el
@@ -508,96 +540,46 @@ fn decode_binary(
         ));
     }
     if fixed {
-        decode_binary_fixed(bytes, pos, el, want, be, min_row)
+        Ok(decode_binary_fixed(bytes, pos, el, want, be, min_row))
     } else {
         decode_binary_rows(path, bytes, pos, el, want, be)
     }
 }
 
-/// Fixed-size rows: each wanted column is filled in parallel chunks of rows.
-fn decode_binary_fixed(
-    bytes: &[u8],
+/// Fixed-size rows: nothing is decoded here; each wanted property becomes a [`Col::Raw`] over
+/// the element's bytes (an offset plan), decoded in parallel when its meaning is known.
+fn decode_binary_fixed<'a>(
+    bytes: &'a [u8],
     pos: &mut usize,
     el: &ElementDef,
     want: &[bool],
     be: bool,
     row_size: usize,
-) -> Result<Vec<Col>> {
-    let n = el.count;
-    let total = n * row_size; // checked by the caller
+) -> Vec<Col<'a>> {
+    let total = el.count * row_size; // checked by the caller
     let body = bytes.get(*pos..*pos + total).unwrap_or(&[]);
-    // Offset plan: (column slot, byte offset in the row, kind) of every wanted property.
-    let mut plan = Vec::new();
-    let mut off = 0;
-    for (p, &w) in el.props.iter().zip(want) {
-        if let PropType::Scalar(k) = p.ty {
-            if w {
-                plan.push((off, k));
-            }
-            off += k.size();
-        }
-    }
-    let mut cols: Vec<Vec<f64>> = plan.iter().map(|_| vec![0.0; n]).collect();
-    if n > 0 && row_size > 0 && !plan.is_empty() {
-        let nchunks = n.div_ceil(CHUNK);
-        let mut per_chunk: Vec<Vec<&mut [f64]>> = (0..nchunks).map(|_| Vec::new()).collect();
-        for col in cols.iter_mut() {
-            for (slot, piece) in per_chunk.iter_mut().zip(col.chunks_mut(CHUNK)) {
-                slot.push(piece);
-            }
-        }
-        per_chunk
-            .into_par_iter()
-            .zip(body.par_chunks(CHUNK * row_size))
-            .for_each(|(outs, rows)| {
-                for (out, &(off, kind)) in outs.into_iter().zip(&plan) {
-                    fill_column(out, rows, row_size, off, kind, be);
-                }
-            });
-    }
     *pos += total;
-    let mut it = cols.into_iter();
-    Ok(el
-        .props
-        .iter()
-        .zip(want)
-        .map(|(_, &w)| {
-            if w {
-                it.next().map_or(Col::Skipped, Col::Scalar)
-            } else {
-                Col::Skipped
-            }
-        })
-        .collect())
-}
-
-/// Decodes the property at byte `off` of every row of `rows` (rows of `rs` bytes) into `out`.
-fn fill_column(out: &mut [f64], rows: &[u8], rs: usize, off: usize, kind: ScalarKind, be: bool) {
-    macro_rules! go {
-        ($t:ty, $n:expr) => {{
-            for (o, row) in out.iter_mut().zip(rows.chunks_exact(rs)) {
-                let b: [u8; $n] = row
-                    .get(off..off + $n)
-                    .and_then(|s| s.try_into().ok())
-                    .unwrap_or([0; $n]);
-                *o = if be {
-                    <$t>::from_be_bytes(b)
-                } else {
-                    <$t>::from_le_bytes(b)
-                } as f64;
-            }
-        }};
+    let mut off = 0;
+    let mut cols = Vec::with_capacity(el.props.len());
+    for (p, &w) in el.props.iter().zip(want) {
+        let PropType::Scalar(kind) = p.ty else {
+            cols.push(Col::Skipped);
+            continue;
+        };
+        cols.push(if w {
+            Col::Raw(RawCol {
+                body,
+                row_size,
+                off,
+                kind,
+                be,
+            })
+        } else {
+            Col::Skipped
+        });
+        off += kind.size();
     }
-    match kind {
-        ScalarKind::I8 => go!(i8, 1),
-        ScalarKind::U8 => go!(u8, 1),
-        ScalarKind::I16 => go!(i16, 2),
-        ScalarKind::U16 => go!(u16, 2),
-        ScalarKind::I32 => go!(i32, 4),
-        ScalarKind::U32 => go!(u32, 4),
-        ScalarKind::F32 => go!(f32, 4),
-        ScalarKind::F64 => go!(f64, 8),
-    }
+    cols
 }
 
 /// Reads one scalar of `kind` at `pos`, or `None` past the end.
@@ -632,8 +614,8 @@ fn decode_binary_rows(
     el: &ElementDef,
     want: &[bool],
     be: bool,
-) -> Result<Vec<Col>> {
-    let mut cols: Vec<Col> = el
+) -> Result<Vec<Col<'static>>> {
+    let mut cols: Vec<Col<'static>> = el
         .props
         .iter()
         .zip(want)
@@ -726,7 +708,7 @@ fn decode_ascii(
     pos: &mut usize,
     el: &ElementDef,
     want: &[bool],
-) -> Result<Vec<Col>> {
+) -> Result<Vec<Col<'static>>> {
     let remaining = bytes.len().saturating_sub(*pos);
     // Every value takes at least one character and one separator (the very last value of the
     // file may lack its newline).
@@ -777,11 +759,11 @@ fn decode_ascii(
         p = end + 1;
     }
     *pos = p.min(bytes.len());
-    let chunks: Vec<Result<Vec<Col>>> = lines
+    let chunks: Vec<Result<Vec<Col<'static>>>> = lines
         .par_chunks(CHUNK)
         .enumerate()
         .map(|(ci, chunk)| {
-            let mut cols: Vec<Col> = el
+            let mut cols: Vec<Col<'static>> = el
                 .props
                 .iter()
                 .zip(want)
@@ -804,7 +786,7 @@ fn decode_ascii(
             Ok(cols)
         })
         .collect();
-    let mut out: Option<Vec<Col>> = None;
+    let mut out: Option<Vec<Col<'static>>> = None;
     for c in chunks {
         let c = c?;
         match &mut out {
@@ -932,14 +914,53 @@ fn scalar_col(el: &ElementDef, cols: &[Col], name: &str) -> Option<usize> {
     el.props
         .iter()
         .zip(cols)
-        .position(|(p, c)| p.name == name && matches!(c, Col::Scalar(_)))
+        .position(|(p, c)| p.name == name && matches!(c, Col::Scalar(_) | Col::Raw(_)))
 }
 
+/// Takes column `i` out of `cols` as values (decoding a raw column in parallel).
 fn take_scalar(cols: &mut [Col], i: usize) -> Vec<f64> {
     match cols.get_mut(i).map(|c| std::mem::replace(c, Col::Skipped)) {
         Some(Col::Scalar(v)) => v,
+        Some(Col::Raw(r)) => r.decode(|row| r.get(row)),
         _ => Vec::new(),
     }
+}
+
+/// Takes three columns out of `cols` and maps each row's three values with `f`: decoded straight
+/// from the rows when they are raw binary, zipped otherwise.
+fn take_triple<'a, T: Send, F: Fn([f64; 3]) -> T + Sync + Send>(
+    cols: &mut [Col<'a>],
+    idx: [usize; 3],
+    f: F,
+) -> Vec<T> {
+    fn raw<'a>(c: Option<&Col<'a>>) -> Option<RawCol<'a>> {
+        match c {
+            Some(Col::Raw(r)) => Some(*r),
+            _ => None,
+        }
+    }
+    if let (Some(a), Some(b), Some(c)) = (
+        raw(cols.get(idx[0])),
+        raw(cols.get(idx[1])),
+        raw(cols.get(idx[2])),
+    ) {
+        for i in idx {
+            if let Some(c) = cols.get_mut(i) {
+                *c = Col::Skipped;
+            }
+        }
+        return a.decode(|row| f([a.get(row), b.get(row), c.get(row)]));
+    }
+    let x = take_scalar(cols, idx[0]);
+    let y = take_scalar(cols, idx[1]);
+    let z = take_scalar(cols, idx[2]);
+    let mut out = Vec::new();
+    x.par_iter()
+        .zip(&y)
+        .zip(&z)
+        .map(|((&a, &b), &c)| f([a, b, c]))
+        .collect_into_vec(&mut out);
+    out
 }
 
 fn kind_of(el: &ElementDef, i: usize) -> ScalarKind {
@@ -953,7 +974,7 @@ fn kind_of(el: &ElementDef, i: usize) -> ScalarKind {
 fn remaining_attributes(el: &ElementDef, cols: &mut [Col], n: usize) -> Result<Attributes> {
     let mut attrs = Attributes::new();
     for (i, p) in el.props.iter().enumerate() {
-        if let Some(Col::Scalar(_)) = cols.get(i) {
+        if let Some(Col::Scalar(_) | Col::Raw(_)) = cols.get(i) {
             let values = take_scalar(cols, i);
             attrs.insert(
                 n,
@@ -983,9 +1004,9 @@ fn to_u8_color(v: f64, kind: ScalarKind) -> u8 {
 
 fn build_vertices(path: &Path, el: &ElementDef, mut cols: Vec<Col>) -> Result<PointCloud> {
     let n = el.count;
-    let mut xyz = Vec::with_capacity(3);
-    for name in ["x", "y", "z"] {
-        let i = scalar_col(el, &cols, name).ok_or_else(|| {
+    let mut xyz = [0usize; 3];
+    for (slot, name) in xyz.iter_mut().zip(["x", "y", "z"]) {
+        *slot = scalar_col(el, &cols, name).ok_or_else(|| {
             Error::format(
                 path,
                 format!(
@@ -994,16 +1015,8 @@ fn build_vertices(path: &Path, el: &ElementDef, mut cols: Vec<Col>) -> Result<Po
                 ),
             )
         })?;
-        xyz.push(take_scalar(&mut cols, i));
     }
-    let [x, y, z]: [Vec<f64>; 3] = xyz.try_into().unwrap_or_default();
-    let mut positions = Vec::with_capacity(n);
-    x.par_iter()
-        .zip(&y)
-        .zip(&z)
-        .map(|((&a, &b), &c)| [a, b, c])
-        .collect_into_vec(&mut positions);
-    let mut cloud = PointCloud::from_positions(positions);
+    let mut cloud = PointCloud::from_positions(take_triple(&mut cols, xyz, |p| p));
     let found = |cols: &[Col], names: [&str; 3]| -> Option<[usize; 3]> {
         let a = scalar_col(el, cols, names[0])?;
         let b = scalar_col(el, cols, names[1])?;
@@ -1011,33 +1024,19 @@ fn build_vertices(path: &Path, el: &ElementDef, mut cols: Vec<Col>) -> Result<Po
         Some([a, b, c])
     };
     let bad = |e: Error| Error::format(path, format!("element `vertex`: {e}"));
-    if let Some([a, b, c]) = found(&cols, ["nx", "ny", "nz"]) {
-        let (nx, ny, nz) = (
-            take_scalar(&mut cols, a),
-            take_scalar(&mut cols, b),
-            take_scalar(&mut cols, c),
-        );
-        let mut normals = Vec::with_capacity(n);
-        nx.par_iter()
-            .zip(&ny)
-            .zip(&nz)
-            .map(|((&a, &b), &c)| [a, b, c])
-            .collect_into_vec(&mut normals);
+    if let Some(idx) = found(&cols, ["nx", "ny", "nz"]) {
+        let normals = take_triple(&mut cols, idx, |p| p);
         cloud.set_normals(normals).map_err(bad)?;
     }
-    if let Some([a, b, c]) = found(&cols, ["red", "green", "blue"]) {
-        let (ka, kb, kc) = (kind_of(el, a), kind_of(el, b), kind_of(el, c));
-        let (r, g, bl) = (
-            take_scalar(&mut cols, a),
-            take_scalar(&mut cols, b),
-            take_scalar(&mut cols, c),
-        );
-        let mut colors = Vec::with_capacity(n);
-        r.par_iter()
-            .zip(&g)
-            .zip(&bl)
-            .map(|((&r, &g), &b)| [to_u8_color(r, ka), to_u8_color(g, kb), to_u8_color(b, kc)])
-            .collect_into_vec(&mut colors);
+    if let Some(idx) = found(&cols, ["red", "green", "blue"]) {
+        let k = idx.map(|i| kind_of(el, i));
+        let colors = take_triple(&mut cols, idx, |c| {
+            [
+                to_u8_color(c[0], k[0]),
+                to_u8_color(c[1], k[1]),
+                to_u8_color(c[2], k[2]),
+            ]
+        });
         cloud.set_colors(colors).map_err(bad)?;
     }
     cloud.attributes = remaining_attributes(el, &mut cols, n).map_err(bad)?;
