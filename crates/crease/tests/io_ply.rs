@@ -300,6 +300,37 @@ fn polygons_are_fan_triangulated_with_attributes_duplicated() {
     }
 }
 
+/// Binary faces that all have four corners (rows of one size, decoded in parallel).
+#[test]
+fn uniform_binary_quads_are_triangulated() {
+    let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty uchar flag\nproperty list uchar uint vertex_indices\nproperty float w\nend_header\n".to_vec();
+    for p in [[0, 0], [1, 0], [1, 1], [0, 1], [2, 0], [2, 1]] {
+        for v in [p[0] as f32, p[1] as f32, 0.0f32] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for (flag, corners, w) in [(1u8, [0u32, 1, 2, 3], 0.5f32), (0, [1, 4, 5, 2], 1.5)] {
+        b.push(flag);
+        b.push(4);
+        for c in corners {
+            b.extend_from_slice(&c.to_le_bytes());
+        }
+        b.extend_from_slice(&w.to_le_bytes());
+    }
+    let (g, report) = ply::read_bytes_ply(Path::new("quads.ply"), &b).expect("read");
+    assert_eq!(report.polygons_triangulated, 2);
+    assert_eq!(g.faces, vec![[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 2]]);
+    let flag = g.face_attributes.get("flag").expect("flag");
+    assert_eq!(
+        (flag.kind, flag.values.clone()),
+        (ScalarKind::U8, vec![1.0, 1.0, 0.0, 0.0])
+    );
+    assert_eq!(
+        g.face_attributes.get("w").expect("w").values,
+        vec![0.5, 0.5, 1.5, 1.5]
+    );
+}
+
 /// Unknown elements and list properties of vertices are skipped, in ascii and binary, and
 /// decoding carries on correctly after them.
 #[test]
@@ -533,6 +564,7 @@ bad! {
     bad_type_name: "bad-type-name", "unknown property type \"flaot\"";
     bad_non_numeric_ascii: "non-numeric-ascii", "\"five\" is not a number";
     bad_face_index_out_of_range: "face-index-out-of-range", "refers to vertex 7";
+    bad_face_index_out_of_range_binary: "face-index-out-of-range-binary", "row 2: corner 2 refers to vertex 3";
     bad_face_negative_index: "face-negative-index", "refers to vertex -1";
     bad_face_two_corners: "face-two-corners", "2 corners";
     bad_no_x_property: "no-x-property", "no scalar property `x`";

@@ -420,6 +420,9 @@ enum Col<'a> {
         offsets: Vec<usize>,
         items: Vec<f64>,
     },
+    /// A list property of binary rows whose lists all have `len` items (so the rows have a fixed
+    /// size): item `k` of row `i` is at byte `i * row_size + off + k * kind.size()`.
+    RawList { raw: RawCol<'a>, len: usize },
 }
 
 /// One property of the fixed-size rows of a binary element (see [`Col::Raw`]).
@@ -541,9 +544,80 @@ fn decode_binary<'a>(
     }
     if fixed {
         Ok(decode_binary_fixed(bytes, pos, el, want, be, min_row))
+    } else if let Some(cols) = decode_binary_uniform(bytes, pos, el, want, be) {
+        Ok(cols)
     } else {
         decode_binary_rows(path, bytes, pos, el, want, be)
     }
+}
+
+/// The common case of one list property whose lists all have the same length (a triangle mesh's
+/// faces): the rows then have a fixed size, checked in parallel, and the element is decoded like
+/// fixed rows. `None` when the element does not have that shape (then it is decoded row by row,
+/// which also finds and reports any error).
+fn decode_binary_uniform<'a>(
+    bytes: &'a [u8],
+    pos: &mut usize,
+    el: &ElementDef,
+    want: &[bool],
+    be: bool,
+) -> Option<Vec<Col<'a>>> {
+    let mut lists = el.props.iter().enumerate().filter_map(|(i, p)| match p.ty {
+        PropType::List { count, item } => Some((i, count, item)),
+        PropType::Scalar(_) => None,
+    });
+    let (li, ck, ik) = lists.next()?;
+    if lists.next().is_some() || el.count == 0 {
+        return None;
+    }
+    let scalar_size = |props: &[PropDef]| -> usize {
+        props
+            .iter()
+            .map(|p| match p.ty {
+                PropType::Scalar(k) => k.size(),
+                PropType::List { .. } => 0,
+            })
+            .sum()
+    };
+    let list_off = scalar_size(el.props.get(..li)?);
+    let c0 = read_scalar(bytes, pos.checked_add(list_off)?, ck, be)?;
+    if c0 < 0.0 {
+        return None;
+    }
+    let len = c0 as usize;
+    let list_bytes = ck.size().checked_add(len.checked_mul(ik.size())?)?;
+    let rs = scalar_size(&el.props).checked_add(list_bytes)?;
+    let total = el.count.checked_mul(rs)?;
+    let body = bytes.get(*pos..pos.checked_add(total)?)?;
+    let uniform = body
+        .par_chunks_exact(rs)
+        .all(|row| read_scalar(row, list_off, ck, be) == Some(c0));
+    if !uniform {
+        return None;
+    }
+    let mut off = 0;
+    let mut cols = Vec::with_capacity(el.props.len());
+    for (p, &w) in el.props.iter().zip(want) {
+        let (kind, size, item_off) = match p.ty {
+            PropType::Scalar(k) => (k, k.size(), off),
+            PropType::List { .. } => (ik, list_bytes, off + ck.size()),
+        };
+        let raw = RawCol {
+            body,
+            row_size: rs,
+            off: item_off,
+            kind,
+            be,
+        };
+        cols.push(match (w, p.ty) {
+            (false, _) => Col::Skipped,
+            (true, PropType::Scalar(_)) => Col::Raw(raw),
+            (true, PropType::List { .. }) => Col::RawList { raw, len },
+        });
+        off += size;
+    }
+    *pos += total;
+    Some(cols)
 }
 
 /// Fixed-size rows: nothing is decoded here; each wanted property becomes a [`Col::Raw`] over
@@ -1060,11 +1134,9 @@ fn build_faces(
     geom: &mut Geometry,
     report: &mut ReadReport,
 ) -> Result<()> {
-    let li = el
-        .props
-        .iter()
-        .zip(&cols)
-        .position(|(p, c)| is_face_index_list(&p.name) && matches!(c, Col::List { .. }));
+    let li = el.props.iter().zip(&cols).position(|(p, c)| {
+        is_face_index_list(&p.name) && matches!(c, Col::List { .. } | Col::RawList { .. })
+    });
     let Some(li) = li else {
         if el.count == 0 {
             return Ok(());
@@ -1077,8 +1149,58 @@ fn build_faces(
             ),
         ));
     };
+    let corner = |f: usize, k: usize, v: f64| -> Result<u32> {
+        vertex_index(v, vertex_count).ok_or_else(|| {
+            Error::format(
+                path,
+                format!(
+                    "element `face` row {f}: corner {k} refers to vertex {v}, but there are {vertex_count} vertices (expected an index in 0..{vertex_count})"
+                ),
+            )
+        })
+    };
     let (offsets, items) = match cols.get_mut(li).map(|c| std::mem::replace(c, Col::Skipped)) {
         Some(Col::List { offsets, items }) => (offsets, items),
+        Some(Col::RawList { raw, len: 3 }) if vertex_count < u32::MAX as usize => {
+            // Triangles with fixed-size rows: decoded and checked in parallel.
+            let size = raw.kind.size();
+            let values = |row: &[u8]| {
+                [0, 1, 2].map(|k| read_scalar(row, raw.off + k * size, raw.kind, raw.be))
+            };
+            let faces = raw.decode(|row| {
+                values(row).map(|v| {
+                    v.and_then(|v| vertex_index(v, vertex_count))
+                        .unwrap_or(u32::MAX)
+                })
+            });
+            if let Some(f) = faces.iter().position(|t| t.contains(&u32::MAX)) {
+                let row = raw.body.chunks_exact(raw.row_size).nth(f).unwrap_or(&[]);
+                for (k, v) in values(row).into_iter().enumerate() {
+                    corner(f, k, v.unwrap_or(f64::NAN))?;
+                }
+            }
+            let n = faces.len();
+            geom.face_attributes = remaining_attributes(el, &mut cols, n)
+                .map_err(|e| Error::format(path, format!("element `face`: {e}")))?;
+            geom.faces = faces;
+            return Ok(());
+        }
+        Some(Col::RawList { raw, len }) => {
+            let size = raw.kind.size();
+            let mut items = vec![0.0; el.count * len];
+            if len > 0 {
+                items
+                    .par_chunks_mut(len)
+                    .zip(raw.body.par_chunks_exact(raw.row_size))
+                    .for_each(|(out, row)| {
+                        for (k, o) in out.iter_mut().enumerate() {
+                            *o = read_scalar(row, raw.off + k * size, raw.kind, raw.be)
+                                .unwrap_or(f64::NAN);
+                        }
+                    });
+            }
+            ((0..=el.count).map(|i| i * len).collect(), items)
+        }
         _ => (vec![0], Vec::new()),
     };
     let mut faces = Vec::with_capacity(el.count);
@@ -1095,28 +1217,15 @@ fn build_faces(
                 ),
             ));
         }
-        let mut idx = [0u32; 3];
-        let get = |k: usize| -> Result<u32> {
-            let v = corners.get(k).copied().unwrap_or(f64::NAN);
-            vertex_index(v, vertex_count).ok_or_else(|| {
-                Error::format(
-                    path,
-                    format!(
-                        "element `face` row {f}: corner {k} refers to vertex {v}, but there are {vertex_count} vertices (expected an index in 0..{vertex_count})"
-                    ),
-                )
-            })
-        };
-        idx[0] = get(0)?;
+        let get = |k: usize| corner(f, k, corners.get(k).copied().unwrap_or(f64::NAN));
+        let first = get(0)?;
         let mut prev = get(1)?;
         if corners.len() > 3 {
             polygons += 1;
         }
         for k in 2..corners.len() {
             let cur = get(k)?;
-            idx[1] = prev;
-            idx[2] = cur;
-            faces.push(idx);
+            faces.push([first, prev, cur]);
             source_row.push(f);
             prev = cur;
         }
