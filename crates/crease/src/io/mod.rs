@@ -251,7 +251,8 @@ pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<(Geometry, Rea
         _ => return Err(disabled(path, format)),
     };
     drop_nonfinite(path, &mut geom, &mut report, opts.strict)?;
-    geom.validate().map_err(|e| Error::format(path, e.to_string()))?;
+    geom.validate()
+        .map_err(|e| Error::format(path, e.to_string()))?;
     Ok((geom, report))
 }
 
@@ -266,7 +267,10 @@ pub fn read_mesh(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<(TriMesh,
     let path = path.as_ref();
     let (g, r) = read(path, opts)?;
     let mesh = g.into_mesh().ok_or_else(|| {
-        Error::format(path, "the file holds no faces, but a triangle mesh is needed")
+        Error::format(
+            path,
+            "the file holds no faces, but a triangle mesh is needed",
+        )
     })?;
     Ok((mesh, r))
 }

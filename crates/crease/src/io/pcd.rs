@@ -7,10 +7,16 @@ use crate::{Error, Result};
 
 /// Reads a pcd file.
 pub fn read(path: &Path) -> Result<(Geometry, ReadReport)> {
-    Err(Error::Unsupported { path: path.to_path_buf(), message: "not yet".into() })
+    Err(Error::Unsupported {
+        path: path.to_path_buf(),
+        message: "not yet".into(),
+    })
 }
 
 /// Writes a pcd file.
 pub fn write(path: &Path, _geom: &Geometry, _opts: &WriteOptions) -> Result<()> {
-    Err(Error::Unsupported { path: path.to_path_buf(), message: "not yet".into() })
+    Err(Error::Unsupported {
+        path: path.to_path_buf(),
+        message: "not yet".into(),
+    })
 }
