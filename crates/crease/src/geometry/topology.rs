@@ -14,6 +14,8 @@
 //!   its slot in [`MeshTopology::face_edges`] holds [`NO_EDGE`].
 //! - An edge's "faces" are face sides: a face lying on an edge once appears once in its row.
 
+use std::sync::atomic::{AtomicU32, Ordering};
+
 use rayon::prelude::*;
 
 use super::{vec3, Point3, TriMesh};
@@ -120,6 +122,9 @@ pub struct MeshTopology {
     edge_faces: Csr,
     /// Parallel to `edge_faces.indices`: the side of the face lying on the edge (0, 1, 2).
     edge_face_sides: Vec<u8>,
+    /// Parallel to `edge_faces.indices`: true if the face side goes from the upper to the lower
+    /// vertex of the edge.
+    side_reversed: Vec<bool>,
     vertex_faces: Csr,
     vertex_edges: Csr,
     vertex_kinds: Vec<VertexKind>,
@@ -199,7 +204,7 @@ impl MeshTopology {
     /// Inputs: `mesh` with `V` vertices and `F` faces (any faces: soups, repeated indices,
     /// non-manifold or inconsistently oriented configurations are all accepted and reported).
     /// Output: the topology, or `Error::InvalidInput` if a face index is `>= V` or the mesh is
-    /// too large for 32-bit incidence lists (`3F + V >= 2^32`).
+    /// too large for 32-bit incidence lists (`3F + V >= 2^31`).
     ///
     /// Cost: O(V + F) plus per-vertex sorts of the few half-edges and faces around each vertex,
     /// in parallel; about 0.2 s for a million triangles on two cores.
@@ -207,15 +212,16 @@ impl MeshTopology {
         mesh.check_indices()?;
         let nv = mesh.num_vertices();
         let nf = mesh.num_faces();
-        if (3 * nf as u64) + nv as u64 >= u64::from(u32::MAX) {
+        if 3 * nf as u64 + nv as u64 >= 1 << 31 {
             return Err(Error::InvalidInput(format!(
                 "mesh too large for edge topology: {nv} vertices and {nf} faces \
-                 (3 x faces + vertices must stay below 2^32)"
+                 (3 x faces + vertices must stay below 2^31)"
             )));
         }
         let faces = mesh.faces.clone();
 
-        // 1. Half-edges bucketed by their lower endpoint: (upper << 32 | 3f + side).
+        // 1. Half-edges bucketed by their lower endpoint, packed as
+        //    upper << 32 | (3 f + side) << 1 | reversed.
         let mut counts = vec![0u32; nv];
         for f in &faces {
             for i in 0..3 {
@@ -226,6 +232,7 @@ impl MeshTopology {
             }
         }
         let half_offsets = Csr::offsets_from_counts(&counts);
+        drop(counts);
         let mut packed = vec![0u64; half_offsets[nv] as usize];
         {
             let mut cursor: Vec<u32> = half_offsets[..nv].to_vec();
@@ -234,8 +241,9 @@ impl MeshTopology {
                     let (a, b) = (f[i], f[(i + 1) % 3]);
                     if a != b {
                         let lo = a.min(b) as usize;
-                        packed[cursor[lo] as usize] =
-                            (u64::from(a.max(b)) << 32) | (3 * fi + i) as u64;
+                        packed[cursor[lo] as usize] = (u64::from(a.max(b)) << 32)
+                            | (((3 * fi + i) as u64) << 1)
+                            | u64::from(a > b);
                         cursor[lo] += 1;
                     }
                 }
@@ -258,12 +266,14 @@ impl MeshTopology {
             })
             .collect();
         let lower_offsets = Csr::offsets_from_counts(&edge_counts);
+        drop(edge_counts);
         let ne = lower_offsets[nv] as usize;
 
-        // 2. Edges and edge -> face sides, straight from the sorted buckets.
+        // 2. Edges, edge -> face sides and face -> edges, straight from the sorted buckets.
         let mut edges = vec![[0u32; 2]; ne];
         let mut ef_offsets = vec![0u32; ne + 1];
         ef_offsets[ne] = packed.len() as u32;
+        let slots: Vec<AtomicU32> = (0..3 * nf).map(|_| AtomicU32::new(NO_EDGE)).collect();
         rows_mut(&lower_offsets, &mut edges)
             .into_par_iter()
             .zip(rows_mut(&lower_offsets, &mut ef_offsets[..ne]).into_par_iter())
@@ -271,6 +281,7 @@ impl MeshTopology {
             .for_each(|(v, (erow, orow))| {
                 let base = half_offsets[v] as usize;
                 let bucket = &packed[base..half_offsets[v + 1] as usize];
+                let first = lower_offsets[v];
                 let mut k = 0;
                 let mut last = u64::MAX;
                 for (j, &h) in bucket.iter().enumerate() {
@@ -280,15 +291,23 @@ impl MeshTopology {
                         orow[k] = (base + j) as u32;
                         k += 1;
                     }
+                    let side = (h as u32 >> 1) as usize;
+                    slots[side].store(first + k as u32 - 1, Ordering::Relaxed);
                 }
             });
+        let face_edges: Vec<[u32; 3]> = slots
+            .par_chunks(3)
+            .map(|c| [0, 1, 2].map(|i| c[i].load(Ordering::Relaxed)))
+            .collect();
+        drop(slots);
         let (ef_indices, edge_face_sides): (Vec<u32>, Vec<u8>) = packed
             .par_iter()
             .map(|&h| {
-                let h = (h & 0xffff_ffff) as u32;
+                let h = h as u32 >> 1;
                 (h / 3, (h % 3) as u8)
             })
             .unzip();
+        let side_reversed: Vec<bool> = packed.par_iter().map(|&h| h & 1 == 1).collect();
         drop(packed);
         let edge_faces = Csr {
             offsets: ef_offsets,
@@ -300,61 +319,51 @@ impl MeshTopology {
             faces,
             edges,
             lower_offsets,
+            face_edges,
             edge_faces,
             edge_face_sides,
+            side_reversed,
             ..Default::default()
         };
 
-        // 3. Face -> edges by lookup.
-        topo.face_edges = topo
-            .faces
-            .par_iter()
-            .map(|f| {
-                let mut fe = [NO_EDGE; 3];
-                for (i, slot) in fe.iter_mut().enumerate() {
-                    if let Some(e) = topo.edge_index(f[i] as usize, f[(i + 1) % 3] as usize) {
-                        *slot = e as u32;
-                    }
-                }
-                fe
-            })
-            .collect();
-
-        // 4. Vertex -> faces (ascending, each face once) and vertex -> edges (ascending).
-        topo.vertex_faces = vertex_face_csr(nv, &topo.faces);
-        topo.vertex_edges = vertex_edge_csr(nv, &topo.edges);
-        topo.num_referenced_vertices = (0..nv)
-            .filter(|&v| topo.vertex_faces.row_len(v) > 0)
-            .count();
-        topo.degenerate_faces = (0..nf as u32)
-            .into_par_iter()
-            .filter(|&f| has_repeated_vertex(topo.faces[f as usize]))
-            .collect();
-
-        // 5. Per-edge classification.
+        // 3. Per-edge classification.
         topo.boundary_edges = topo.edges_where(|t, e| t.edge_faces.row_len(e) == 1);
         topo.non_manifold_edges = topo.edges_where(|t, e| t.edge_faces.row_len(e) > 2);
         topo.inconsistent_edges = topo.edges_where(|t, e| {
             t.edge_faces.row_len(e) == 2 && {
                 let s = t.side_range(e);
-                t.side_is_forward(e, s.start) == t.side_is_forward(e, s.start + 1)
+                t.side_reversed[s.start] == t.side_reversed[s.start + 1]
             }
         });
+        topo.degenerate_faces = (0..nf as u32)
+            .into_par_iter()
+            .filter(|&f| has_repeated_vertex(topo.faces[f as usize]))
+            .collect();
 
-        // 6. Vertex fans: kinds, fan-ordered vertex -> faces rows, one-rings, boundary pairing.
+        // 4. Vertex fans: kinds, fan-ordered vertex -> faces, one-rings, boundary loops.
         topo.analyse_fans();
+        topo.vertex_edges = vertex_edge_csr(nv, &topo.edges);
 
-        // 7. Geometry: face normals and dihedral angles.
-        topo.face_normals = face_normals(mesh);
-        let positions = mesh.positions();
+        // 5. Geometry: face normals and dihedral angles.
+        let p = mesh.positions();
+        let geom: Vec<[Point3; 2]> = topo
+            .faces
+            .par_iter()
+            .map(|&[a, b, c]| {
+                let (a, b, c) = (p[a as usize], p[b as usize], p[c as usize]);
+                let centroid = vec3::scale(vec3::add(vec3::add(a, b), c), 1.0 / 3.0);
+                [triangle_normal(a, b, c), centroid]
+            })
+            .collect();
+        topo.face_normals = geom.par_iter().map(|g| g[0]).collect();
         let (dihedral, signed): (Vec<f64>, Vec<f64>) = (0..ne)
             .into_par_iter()
-            .map(|e| topo.compute_dihedral(e, positions))
+            .map(|e| topo.compute_dihedral(e, &geom))
             .unzip();
         topo.dihedral = dihedral;
         topo.signed_dihedral = signed;
 
-        // 8. Connected components through shared edges.
+        // 6. Connected components through shared edges.
         topo.label_components();
         Ok(topo)
     }
@@ -626,14 +635,6 @@ impl MeshTopology {
         self.edge_faces.offsets[e] as usize..self.edge_faces.offsets[e + 1] as usize
     }
 
-    /// True if the face side at position `k` of `edge_faces.indices` (on edge `e`) goes from
-    /// the edge's lower to its upper vertex.
-    #[inline]
-    fn side_is_forward(&self, e: usize, k: usize) -> bool {
-        let f = self.faces[self.edge_faces.indices[k] as usize];
-        f[self.edge_face_sides[k] as usize] == self.edges[e][0]
-    }
-
     fn edges_where(&self, pred: impl Fn(&Self, usize) -> bool + Sync) -> Vec<u32> {
         (0..self.edges.len() as u32)
             .into_par_iter()
@@ -641,28 +642,25 @@ impl MeshTopology {
             .collect()
     }
 
-    fn compute_dihedral(&self, e: usize, p: &[Point3]) -> (f64, f64) {
+    fn compute_dihedral(&self, e: usize, geom: &[[Point3; 2]]) -> (f64, f64) {
         let r = self.side_range(e);
         if r.len() != 2 {
             return (f64::NAN, f64::NAN);
         }
-        let f1 = self.edge_faces.indices[r.start] as usize;
-        let f2 = self.edge_faces.indices[r.start + 1] as usize;
-        let n1 = self.face_normals[f1];
-        let n2 = self.face_normals[f2];
+        let [n1, c1] = geom[self.edge_faces.indices[r.start] as usize];
+        let [n2, c2] = geom[self.edge_faces.indices[r.start + 1] as usize];
         if n1 == [0.0; 3] || n2 == [0.0; 3] {
             return (f64::NAN, f64::NAN);
         }
-        let c = vec3::cross(n1, n2);
-        let angle = vec3::norm(c).atan2(vec3::dot(n1, n2));
-        let fw1 = self.side_is_forward(e, r.start);
-        if fw1 == self.side_is_forward(e, r.start + 1) {
+        let angle = vec3::norm(vec3::cross(n1, n2)).atan2(vec3::dot(n1, n2));
+        if self.side_reversed[r.start] == self.side_reversed[r.start + 1] {
             return (angle, f64::NAN);
         }
-        let [a, b] = self.edges[e];
-        let d = vec3::sub(p[b as usize], p[a as usize]);
-        let d = if fw1 { d } else { vec3::scale(d, -1.0) };
-        let signed = if vec3::dot(c, d) >= 0.0 {
+        // (n2 - n1) . (c2 - c1) = -3 n1 . (o2 - a) - 3 n2 . (o1 - a) with o the opposite corners
+        // and a a vertex of the edge: positive when each face's far corner lies behind the
+        // other face's plane, i.e. the edge is convex.
+        let s = vec3::dot(vec3::sub(n2, n1), vec3::sub(c2, c1));
+        let signed = if s >= 0.0 || angle == 0.0 {
             angle
         } else {
             -angle
@@ -672,57 +670,43 @@ impl MeshTopology {
 
     fn analyse_fans(&mut self) {
         let nv = self.num_vertices;
-        let mut kinds = vec![VertexKind::Isolated; nv];
-        let mut starts = vec![0u32; nv];
-        let faces = &self.faces;
-        let mut vf_indices = std::mem::take(&mut self.vertex_faces.indices);
-        let offsets = &self.vertex_faces.offsets;
-        // Pairs [v, u1, u2]: boundary edges (v, u1) and (v, u2) bound the same fan at v.
-        let pairs: Vec<[u32; 3]> = rows_mut(offsets, &mut vf_indices)
-            .into_par_iter()
-            .zip(kinds.par_iter_mut())
-            .zip(starts.par_iter_mut())
+        let (vf_offsets, mut wedges) = vertex_wedges(nv, &self.faces);
+        // Ring rows are written with capacity `faces + 1` each, then compacted.
+        let cap_offsets: Vec<u32> = vf_offsets
+            .iter()
             .enumerate()
-            .map_init(FanScratch::default, |s, (v, ((row, kind), start))| {
-                let out = analyse_fan(v as u32, row, faces, s);
-                *kind = out.0;
-                *start = out.1;
+            .map(|(v, &o)| o + v as u32)
+            .collect();
+        let mut ring_buf = vec![0u32; cap_offsets[nv] as usize];
+        let mut kinds = vec![VertexKind::Isolated; nv];
+        let mut ring_lens = vec![0u32; nv];
+        // Triples [v, u1, u2]: boundary edges (v, u1) and (v, u2) bound the same fan at v.
+        let pairs: Vec<[u32; 3]> = rows_mut(&vf_offsets, &mut wedges)
+            .into_par_iter()
+            .zip(rows_mut(&cap_offsets, &mut ring_buf).into_par_iter())
+            .zip(kinds.par_iter_mut().zip(ring_lens.par_iter_mut()))
+            .enumerate()
+            .map_init(FanScratch::default, |s, (v, ((row, ring), (kind, len)))| {
+                (*kind, *len) = analyse_fan(v as u32, row, ring, s);
                 std::mem::take(&mut s.pairs)
             })
             .flat_map_iter(|p| p.into_iter())
             .collect();
-        self.vertex_faces.indices = vf_indices;
+        self.vertex_faces = Csr {
+            offsets: vf_offsets,
+            indices: wedges.par_iter().map(|w| w[0]).collect(),
+        };
+        drop(wedges);
+        self.num_referenced_vertices = kinds.iter().filter(|&&k| k != VertexKind::Isolated).count();
 
-        // One-rings from the fan-ordered faces.
-        let ring_counts: Vec<u32> = (0..nv)
-            .map(|v| match kinds[v] {
-                VertexKind::Interior => self.vertex_faces.row_len(v) as u32,
-                VertexKind::Boundary => self.vertex_faces.row_len(v) as u32 + 1,
-                _ => 0,
-            })
-            .collect();
-        let ring_offsets = Csr::offsets_from_counts(&ring_counts);
+        let ring_offsets = Csr::offsets_from_counts(&ring_lens);
         let mut ring_indices = vec![0u32; ring_offsets[nv] as usize];
-        let vf = &self.vertex_faces;
         rows_mut(&ring_offsets, &mut ring_indices)
             .into_par_iter()
             .enumerate()
-            .for_each(|(v, ring)| {
-                if ring.is_empty() {
-                    return;
-                }
-                let mut cur = starts[v];
-                ring[0] = cur;
-                for (j, &f) in vf.row(v).iter().enumerate() {
-                    let next = faces[f as usize]
-                        .into_iter()
-                        .find(|&x| x != v as u32 && x != cur)
-                        .unwrap_or(cur);
-                    if let Some(slot) = ring.get_mut(j + 1) {
-                        *slot = next;
-                    }
-                    cur = next;
-                }
+            .for_each(|(v, dst)| {
+                let start = cap_offsets[v] as usize;
+                dst.copy_from_slice(&ring_buf[start..start + dst.len()]);
             });
         self.rings = Csr {
             offsets: ring_offsets,
@@ -791,7 +775,10 @@ fn rows_mut<'a, T>(offsets: &[u32], mut data: &'a mut [T]) -> Vec<&'a mut [T]> {
     rows
 }
 
-fn vertex_face_csr(nv: usize, faces: &[[u32; 3]]) -> Csr {
+/// Vertex -> wedges: per vertex `v`, one `[f, a, b]` per face `f` using `v` (each face once,
+/// ascending `f`), `a` and `b` being the corners after `v` in the face's order.
+/// Output: `(offsets, wedges)` with `V + 1` offsets.
+fn vertex_wedges(nv: usize, faces: &[[u32; 3]]) -> (Vec<u32>, Vec<[u32; 3]>) {
     let mut counts = vec![0u32; nv];
     let distinct = |f: &[u32; 3], i: usize| (0..i).all(|j| f[j] != f[i]);
     for f in faces {
@@ -802,18 +789,19 @@ fn vertex_face_csr(nv: usize, faces: &[[u32; 3]]) -> Csr {
         }
     }
     let offsets = Csr::offsets_from_counts(&counts);
-    let mut indices = vec![0u32; offsets[nv] as usize];
+    drop(counts);
+    let mut wedges = vec![[0u32; 3]; offsets[nv] as usize];
     let mut cursor: Vec<u32> = offsets[..nv].to_vec();
     for (fi, f) in faces.iter().enumerate() {
         for i in 0..3 {
             if distinct(f, i) {
                 let c = &mut cursor[f[i] as usize];
-                indices[*c as usize] = fi as u32;
+                wedges[*c as usize] = [fi as u32, f[(i + 1) % 3], f[(i + 2) % 3]];
                 *c += 1;
             }
         }
     }
-    Csr { offsets, indices }
+    (offsets, wedges)
 }
 
 fn vertex_edge_csr(nv: usize, edges: &[[u32; 2]]) -> Csr {
@@ -840,22 +828,21 @@ fn vertex_edge_csr(nv: usize, edges: &[[u32; 2]]) -> Csr {
 struct FanScratch {
     /// (node << 32 | wedge << 1 | end), sorted by node.
     entries: Vec<u64>,
-    /// Wedge endpoints: wedge k of face (v, a, b) joins a (end 0) and b (end 1).
-    ends: Vec<[u32; 2]>,
     parent: Vec<u32>,
     boundary: Vec<(u32, u32)>,
     order: Vec<u32>,
-    row_copy: Vec<u32>,
+    row_copy: Vec<[u32; 3]>,
     pairs: Vec<[u32; 3]>,
 }
 
-/// Classifies vertex `v` from its faces `row` (ascending), reorders `row` into fan order when
-/// the vertex is manifold, and leaves in `s.pairs` the boundary-edge pairs bounding a same fan.
-/// Returns the kind and the first ring neighbour.
+/// Classifies vertex `v` from its wedges `row` (`[f, a, b]`, ascending `f`). For a manifold
+/// vertex, reorders `row` into fan order and writes the one-ring into `ring` (capacity
+/// `row.len() + 1`). Leaves in `s.pairs` the boundary-edge pairs bounding a same fan.
+/// Returns the kind and the ring's length.
 fn analyse_fan(
     v: u32,
-    row: &mut [u32],
-    faces: &[[u32; 3]],
+    row: &mut [[u32; 3]],
+    ring: &mut [u32],
     s: &mut FanScratch,
 ) -> (VertexKind, u32) {
     s.pairs.clear();
@@ -863,19 +850,14 @@ fn analyse_fan(
     if d == 0 {
         return (VertexKind::Isolated, 0);
     }
+    // Wedge k joins a (end 0) and b (end 1); degenerate faces take no part.
     s.entries.clear();
-    s.ends.clear();
     let mut degenerate = false;
-    for (k, &f) in row.iter().enumerate() {
-        let f = faces[f as usize];
-        if has_repeated_vertex(f) {
+    for (k, &[_, a, b]) in row.iter().enumerate() {
+        if a == v || b == v || a == b {
             degenerate = true;
-            s.ends.push([u32::MAX; 2]);
             continue;
         }
-        let i = f.iter().position(|&x| x == v).unwrap_or(0);
-        let (a, b) = (f[(i + 1) % 3], f[(i + 2) % 3]);
-        s.ends.push([a, b]);
         s.entries.push((u64::from(a) << 32) | ((k as u64) << 1));
         s.entries.push((u64::from(b) << 32) | ((k as u64) << 1) | 1);
     }
@@ -892,10 +874,8 @@ fn analyse_fan(
         let node = s.entries[i] >> 32;
         let mut j = i + 1;
         while j < n && s.entries[j] >> 32 == node {
-            let (a, b) = (
-                (s.entries[i] as u32 >> 1) as usize,
-                (s.entries[j] as u32 >> 1) as usize,
-            );
+            let a = (s.entries[i] as u32 >> 1) as usize;
+            let b = (s.entries[j] as u32 >> 1) as usize;
             local_union(&mut s.parent, a, b);
             j += 1;
         }
@@ -905,7 +885,7 @@ fn analyse_fan(
         }
         i = j;
     }
-    // Boundary nodes grouped by component root.
+    // Boundary nodes grouped by component root; consecutive ones in a group are paired.
     for b in s.boundary.iter_mut() {
         let wedge = (s.entries[b.1 as usize] as u32 >> 1) as usize;
         b.0 = local_find(&mut s.parent, wedge) as u32;
@@ -918,13 +898,13 @@ fn analyse_fan(
             s.pairs.push([v, u1, u2]);
         }
     }
-    let mut components = 0;
-    for k in 0..d {
-        if s.ends[k][0] != u32::MAX && local_find(&mut s.parent, k) == k {
-            components += 1;
-        }
+    if degenerate || max_deg > 2 {
+        return (VertexKind::NonManifold, 0);
     }
-    if degenerate || max_deg > 2 || components != 1 {
+    let components = (0..d)
+        .filter(|&k| local_find(&mut s.parent, k) == k)
+        .count();
+    if components != 1 {
         return (VertexKind::NonManifold, 0);
     }
 
@@ -933,28 +913,33 @@ fn analyse_fan(
     let (mut wedge, mut from_end) = if closed {
         (0usize, 0usize)
     } else {
-        // Two boundary nodes; prefer the one that is its face's `a` (listed right after v),
-        // then the lower face.
-        let cand = |pos: u32| {
+        // Two boundary nodes; prefer the one listed right after v in its face (end 0), then
+        // the lower face.
+        let at = |pos: u32| {
             let e = s.entries[pos as usize];
-            ((e as u32 >> 1) as usize, (e & 1) as usize)
+            ((e & 1) as usize, (e as u32 >> 1) as usize)
         };
-        let (w1, e1) = cand(s.boundary[0].1);
-        let (w2, e2) = cand(s.boundary[1].1);
+        let (e1, w1) = at(s.boundary[0].1);
+        let (e2, w2) = at(s.boundary[1].1);
         if (e1, w1) <= (e2, w2) {
             (w1, e1)
         } else {
             (w2, e2)
         }
     };
-    let start = s.ends[wedge][from_end];
+    let len = if closed { d } else { d + 1 };
+    ring[0] = row[wedge][1 + from_end];
     s.order.clear();
-    for _ in 0..d {
+    for step in 0..d {
         s.order.push(wedge as u32);
-        let node = u64::from(s.ends[wedge][1 - from_end]);
-        let lo = s.entries.partition_point(|&x| x >> 32 < node);
+        let node = row[wedge][2 - from_end];
+        if step + 1 < len {
+            ring[step + 1] = node;
+        }
+        let key = u64::from(node);
+        let lo = s.entries.partition_point(|&x| x >> 32 < key);
         let mut next = None;
-        for &x in s.entries[lo..].iter().take_while(|&&x| x >> 32 == node) {
+        for &x in s.entries[lo..].iter().take_while(|&&x| x >> 32 == key) {
             let w = (x as u32 >> 1) as usize;
             if w != wedge {
                 next = Some((w, (x & 1) as usize));
@@ -981,7 +966,7 @@ fn analyse_fan(
     } else {
         VertexKind::Boundary
     };
-    (kind, start)
+    (kind, len as u32)
 }
 
 fn local_find(parent: &mut [u32], mut x: usize) -> usize {
