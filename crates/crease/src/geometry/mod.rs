@@ -16,4 +16,6 @@ pub use cleanup::{clean_mesh, CleanupParams, CleanupReport};
 pub use mesh::TriMesh;
 pub use point_cloud::{Point3, PointCloud};
 pub use spacing::{average_spacing, average_spacing_with};
-pub use topology::MeshTopology;
+pub use topology::{
+    face_area, face_areas, face_normal, face_normals, Csr, MeshTopology, OneRing, VertexKind,
+};
