@@ -60,7 +60,7 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
     let mesh_path = dir.join("part-mesh.ply");
     let mesh_faces = m.mesh.num_faces();
     let mesh_vertices = m.mesh.num_vertices();
-    let topo = crease::geometry::MeshTopology::new(&m.mesh);
+    let topo = crease::geometry::MeshTopology::new(&m.mesh)?;
     let mesh_curves = m.curves_geometry();
     super::save(
         g,
@@ -133,7 +133,7 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
         "mesh": {
             "vertices": mesh_vertices,
             "faces": mesh_faces,
-            "edges": topo.edges.len(),
+            "edges": topo.num_edges(),
             "closed_manifold": topo.is_closed_manifold(),
         },
         "files": ["part.ply", "part.curves.ply", "part.truth.json", "part-mesh.ply",

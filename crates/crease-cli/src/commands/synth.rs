@@ -65,7 +65,7 @@ pub fn run(g: &Global, a: &SynthArgs) -> anyhow::Result<()> {
             },
         )?;
         let curves = m.curves_geometry();
-        let truth = m.ground_truth_json();
+        let truth = m.ground_truth_json(&shape);
         (crease::io::Geometry::from_mesh(m.mesh), curves, truth)
     } else {
         let p = synth::sample_points(

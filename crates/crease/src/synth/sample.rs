@@ -462,3 +462,24 @@ impl SyntheticPart {
         )
     }
 }
+
+impl super::SyntheticMesh {
+    /// A JSON summary like [`SyntheticPart::ground_truth_json`], for the mesh of `shape`:
+    /// surfaces with parameters and vertex counts, curves, the numbers of exact sharp / smooth
+    /// mesh edges, the mean edge length and the label tolerance.
+    pub fn ground_truth_json(&self, shape: &Shape) -> serde_json::Value {
+        ground_truth_json(
+            shape,
+            &self.mesh.vertices,
+            &self.surfaces,
+            &self.curves,
+            json!({
+                "faces": self.mesh.faces.len(),
+                "sharp_edges": self.sharp_edges.len(),
+                "smooth_edges": self.smooth_edges.len(),
+                "mean_edge": self.mean_edge,
+                "sharp_tolerance": self.sharp_tolerance,
+            }),
+        )
+    }
+}
