@@ -249,6 +249,22 @@ fn cube_with_a_flipped_face() {
 }
 
 #[test]
+fn inside_out_cube_is_concave_everywhere() {
+    let mut m = cube();
+    for f in &mut m.faces {
+        f.swap(1, 2);
+    }
+    let t = MeshTopology::new(&m).unwrap();
+    assert!(t.is_oriented());
+    let s = t.signed_dihedral_angles();
+    assert_eq!(
+        s.iter().filter(|&&a| (a + FRAC_PI_2).abs() < 1e-15).count(),
+        12
+    );
+    assert_eq!(s.iter().filter(|&&a| a == 0.0).count(), 6);
+}
+
+#[test]
 fn l_prism_concave_edge() {
     let m = l_prism();
     let t = MeshTopology::new(&m).unwrap();
@@ -558,6 +574,20 @@ fn large_grid_counts() {
     assert_eq!(closed, interior as usize);
 }
 
+/// CPU seconds used by this process so far (Linux; 0 elsewhere).
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    let Some(rest) = stat.rsplit(')').next() else {
+        return 0.0;
+    };
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11).and_then(|x| x.parse().ok()).unwrap_or(0.0)
+        + f.get(12).and_then(|x| x.parse().ok()).unwrap_or(0.0);
+    ticks / 100.0
+}
+
 /// Times topology and clean-up on ~1M triangles (a grid with shuffled vertex ids).
 /// `cargo test --release -p crease --test mesh_topology -- --ignored --nocapture`
 #[test]
@@ -580,13 +610,14 @@ fn timing_one_million_triangles() {
         .collect();
     let m = TriMesh::new(pos, faces).unwrap();
     for _ in 0..3 {
-        let t0 = std::time::Instant::now();
+        let (t0, c0) = (std::time::Instant::now(), cpu_seconds());
         let t = MeshTopology::new(&m).unwrap();
         eprintln!(
-            "topology: {} faces, {} edges in {:.3} s",
+            "topology: {} faces, {} edges in {:.3} s wall, {:.2} s cpu",
             t.num_faces(),
             t.num_edges(),
-            t0.elapsed().as_secs_f64()
+            t0.elapsed().as_secs_f64(),
+            cpu_seconds() - c0
         );
     }
     // the same mesh as an STL soup
@@ -601,9 +632,13 @@ fn timing_one_million_triangles() {
     }
     let soup = TriMesh::new(p, f).unwrap();
     for _ in 0..2 {
-        let t0 = std::time::Instant::now();
+        let (t0, c0) = (std::time::Instant::now(), cpu_seconds());
         let (c, r) = clean_mesh(&soup, &CleanupParams::default()).unwrap();
-        eprintln!("clean-up: {r} in {:.3} s", t0.elapsed().as_secs_f64());
+        eprintln!(
+            "{r} in {:.3} s wall, {:.2} s cpu",
+            t0.elapsed().as_secs_f64(),
+            cpu_seconds() - c0
+        );
         assert_eq!(c.num_vertices(), m.num_vertices());
     }
 }

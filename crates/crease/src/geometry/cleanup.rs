@@ -7,7 +7,7 @@
 
 use std::collections::HashMap;
 use std::fmt;
-use std::hash::{BuildHasherDefault, Hash, Hasher};
+use std::hash::{BuildHasherDefault, Hasher};
 
 use rayon::prelude::*;
 
@@ -456,90 +456,126 @@ fn mean_edge_length(p: &[Point3], faces: &[[u32; 3]]) -> f64 {
 /// (Euclidean distance `<= tol`), else itself. `tol == 0` merges bit-identical positions.
 ///
 /// Inputs: `V` positions, `tol >= 0`. Output: `V` representative indices (`rep[rep[i]] == rep[i]`).
+///
+/// Bit-identical positions are grouped first (a parallel sort); the greedy tolerance pass then
+/// runs over the distinct positions only, which gives the same result as running it over all
+/// vertices (a group's members share their first member's candidates).
 fn merge_representatives(p: &[Point3], tol: f64) -> Vec<u32> {
-    let n = p.len();
-    let finite = |i: usize| p[i].iter().all(|c| c.is_finite());
+    let mut rep = exact_representatives(p);
     let Some(bbox) = finite_aabb(p) else {
-        return (0..n as u32).collect();
+        return rep;
     };
-    // Grid of cell size 2 tol: a point within tol of x lies in x's cell or, per axis, in the
-    // neighbour on the side of the nearer cell face, so at most 8 cells are searched.
-    let cell = 2.0 * tol;
-    let too_fine = tol == 0.0 || bbox.diagonal() / cell > 1e15;
-    if too_fine {
-        return exact_representatives(p);
+    // Grid of cell size 8 tol: a point within tol of x lies in x's cell or, on an axis where x
+    // is closer than tol to a cell face, in the neighbour across it; most points need no
+    // neighbour cell at all.
+    let cell = CELL_FACTOR * tol;
+    if tol == 0.0 || bbox.diagonal() / cell > 1e15 {
+        return rep;
     }
+    let finite = |i: usize| p[i].iter().all(|c| c.is_finite());
     let cell_of = |x: Point3| -> ([i64; 3], [f64; 3]) {
         let mut c = [0i64; 3];
         let mut frac = [0.0; 3];
         for k in 0..3 {
-            let t = (x[k] - bbox.min[k]) / cell;
+            let t = (x[k] - bbox.min[k]) / cell + GRID_SHIFT;
             let fl = t.floor();
             c[k] = fl as i64;
             frac[k] = t - fl;
         }
         (c, frac)
     };
-    let mut order: Vec<([i64; 3], u32)> = (0..n as u32)
+    let cell_hash = |c: [i64; 3]| mix3(c.map(|x| x as u64));
+    // Distinct points sorted by (cell hash, index); each run of one hash is looked up by hash
+    // (cells sharing a hash share a run, which only adds candidates that fail the distance test).
+    let mut order: Vec<(u64, u32)> = (0..p.len() as u32)
         .into_par_iter()
-        .filter(|&i| finite(i as usize))
-        .map(|i| (cell_of(p[i as usize]).0, i))
+        .filter(|&i| rep[i as usize] == i && finite(i as usize))
+        .map(|i| (cell_hash(cell_of(p[i as usize]).0), i))
         .collect();
     order.par_sort_unstable();
-    let mut cells: HashMap<Cell, (u32, u32), BuildHasherDefault<CellHasher>> =
-        HashMap::with_capacity_and_hasher(order.len() / 2 + 1, Default::default());
+    let mut runs: HashMap<u64, (u32, u32), BuildHasherDefault<PremixedHasher>> =
+        HashMap::with_capacity_and_hasher(order.len(), Default::default());
+    let mut run_of = vec![(0u32, 0u32); order.len()];
     let mut start = 0;
     for run in order.chunk_by(|a, b| a.0 == b.0) {
-        cells.insert(Cell(run[0].0), (start as u32, (start + run.len()) as u32));
+        let r = (start as u32, (start + run.len()) as u32);
+        runs.insert(run[0].0, r);
+        run_of[start..start + run.len()].fill(r);
         start += run.len();
     }
     let tol2 = tol * tol;
-    // Earlier vertices within tol, ascending, per vertex (empty for most).
-    let candidates: Vec<Vec<u32>> = (0..n)
-        .into_par_iter()
-        .map(|i| {
+    let near = 1.0 / CELL_FACTOR + 1e-9;
+    // Pairs (i, j): j < i, distinct points within tol (rare).
+    let mut pairs: Vec<(u32, u32)> = order
+        .par_iter()
+        .zip(run_of.par_iter())
+        .flat_map_iter(|(&(_, i), &(s, e))| {
+            let i = i as usize;
             let mut out = Vec::new();
-            if !finite(i) {
-                return out;
-            }
-            let (c, frac) = cell_of(p[i]);
-            let dir = |k: usize| -> i64 {
-                if frac[k] < 0.5 {
-                    -1
-                } else {
-                    1
+            let mut scan = |range: &[(u64, u32)]| {
+                for &(_, j) in range {
+                    if (j as usize) < i && vec3::dist2(p[j as usize], p[i]) <= tol2 {
+                        out.push((i as u32, j));
+                    }
                 }
             };
-            let (dx, dy, dz) = (dir(0), dir(1), dir(2));
-            for ox in [0, dx] {
-                for oy in [0, dy] {
-                    for oz in [0, dz] {
-                        let key = Cell([c[0] + ox, c[1] + oy, c[2] + oz]);
-                        let Some(&(s, e)) = cells.get(&key) else {
-                            continue;
-                        };
-                        for &(_, j) in &order[s as usize..e as usize] {
-                            if (j as usize) < i && vec3::dist2(p[j as usize], p[i]) <= tol2 {
-                                out.push(j);
+            scan(&order[s as usize..e as usize]);
+            let (c, frac) = cell_of(p[i]);
+            let steps = |k: usize| -> [i64; 3] {
+                [
+                    0,
+                    if frac[k] < near { -1 } else { 0 },
+                    if frac[k] > 1.0 - near { 1 } else { 0 },
+                ]
+            };
+            let (sx, sy, sz) = (steps(0), steps(1), steps(2));
+            if sx[1..] != [0, 0] || sy[1..] != [0, 0] || sz[1..] != [0, 0] {
+                let own = cell_hash(c);
+                let mut seen = [own; 27];
+                let mut nseen = 1;
+                for ox in sx {
+                    for oy in sy {
+                        for oz in sz {
+                            let key = cell_hash([c[0] + ox, c[1] + oy, c[2] + oz]);
+                            if seen[..nseen].contains(&key) {
+                                continue;
+                            }
+                            seen[nseen] = key;
+                            nseen += 1;
+                            if let Some(&(s, e)) = runs.get(&key) {
+                                scan(&order[s as usize..e as usize]);
                             }
                         }
                     }
                 }
             }
-            out.sort_unstable();
-            out
+            out.into_iter()
         })
         .collect();
-    let mut rep: Vec<u32> = (0..n as u32).collect();
-    for i in 0..n {
-        if let Some(&j) = candidates[i].iter().find(|&&j| rep[j as usize] == j) {
+    pairs.par_sort_unstable();
+    // Greedy in index order: join the lowest earlier representative within tol.
+    for group in pairs.chunk_by(|a, b| a.0 == b.0) {
+        let i = group[0].0 as usize;
+        if let Some(&(_, j)) = group.iter().find(|&&(_, j)| rep[j as usize] == j) {
             rep[i] = j;
         }
+    }
+    // Group members follow their first member.
+    for i in 0..rep.len() {
+        rep[i] = rep[rep[i] as usize];
     }
     rep
 }
 
-/// Representatives for bit-identical positions (`-0.0` equal to `0.0`; non-finite never merged).
+/// Grid cell size in units of the merge tolerance.
+const CELL_FACTOR: f64 = 8.0;
+/// Offset of the grid from the bounding-box corner, in cells: an irrational-looking fraction so
+/// that round CAD coordinates do not fall on cell faces (which would make every point look up
+/// its neighbour cells).
+const GRID_SHIFT: f64 = 0.381_966_011_250_105;
+
+/// Representatives for bit-identical positions (`-0.0` equal to `0.0`; non-finite never merged):
+/// the lowest index of each group.
 fn exact_representatives(p: &[Point3]) -> Vec<u32> {
     let key = |x: Point3| x.map(|c| if c == 0.0 { 0u64 } else { c.to_bits() });
     let mut order: Vec<([u64; 3], u32)> = (0..p.len() as u32)
@@ -558,34 +594,33 @@ fn exact_representatives(p: &[Point3]) -> Vec<u32> {
     rep
 }
 
-/// A grid cell, hashed by its three coordinates.
-#[derive(PartialEq, Eq)]
-struct Cell([i64; 3]);
-
-impl Hash for Cell {
-    fn hash<H: Hasher>(&self, state: &mut H) {
-        for &c in &self.0 {
-            state.write_u64(c as u64);
-        }
+/// A 64-bit hash of three words (splitmix64 finaliser chain).
+#[inline]
+fn mix3(x: [u64; 3]) -> u64 {
+    #[inline]
+    fn fmix(mut z: u64) -> u64 {
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
     }
+    fmix(x[2] ^ fmix(x[1] ^ fmix(x[0].wrapping_add(0x9e37_79b9_7f4a_7c15))))
 }
 
-/// A small multiplicative hasher for grid cells (FxHash-like; inputs are not adversarial
-/// beyond costing time, since cells are checked for equality).
+/// A hasher for keys that are already well-mixed 64-bit hashes.
 #[derive(Default)]
-struct CellHasher(u64);
+struct PremixedHasher(u64);
 
-impl Hasher for CellHasher {
+impl Hasher for PremixedHasher {
     fn finish(&self) -> u64 {
-        self.0 ^ (self.0 >> 29)
+        self.0
     }
     fn write(&mut self, bytes: &[u8]) {
         for &b in bytes {
-            self.write_u64(u64::from(b));
+            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
         }
     }
     fn write_u64(&mut self, x: u64) {
-        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x517c_c1b7_2722_0a95);
+        self.0 = x;
     }
 }
 
@@ -604,6 +639,24 @@ mod tests {
         ];
         assert_eq!(merge_representatives(&p, 1.0), vec![0, 0, 2, 0]);
         assert_eq!(merge_representatives(&p, 0.0), vec![0, 1, 2, 3]);
+    }
+
+    #[test]
+    fn merge_at_exactly_the_tolerance_on_round_coordinates() {
+        let mut p = Vec::new();
+        for i in 0..50 {
+            for j in 0..50 {
+                p.push([i as f64, j as f64, 0.0]);
+                p.push([i as f64 + 0.25, j as f64, 0.0]);
+            }
+        }
+        let rep = merge_representatives(&p, 0.25);
+        for k in 0..p.len() / 2 {
+            assert_eq!(rep[2 * k], 2 * k as u32);
+            assert_eq!(rep[2 * k + 1], 2 * k as u32);
+        }
+        let rep = merge_representatives(&p, 0.249);
+        assert!(rep.iter().enumerate().all(|(i, &r)| r as usize == i));
     }
 
     #[test]
