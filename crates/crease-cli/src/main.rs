@@ -20,7 +20,10 @@ fn main() -> ExitCode {
     };
     ui::init_logging(cli.global.verbose, cli.global.quiet);
     if let Some(n) = cli.global.threads {
-        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+        {
             eprintln!("error: cannot start {n} threads: {e}");
             return ExitCode::from(1);
         }

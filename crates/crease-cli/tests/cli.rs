@@ -47,7 +47,9 @@ fn every_shared_data_file_loads_with_info() {
     let Some(dir) = data_dir() else { return };
     let mut files = Vec::new();
     files_under(&dir, &mut files);
-    let geometry_exts = ["ply", "obj", "off", "stl", "xyz", "pcd", "las", "laz", "e57"];
+    let geometry_exts = [
+        "ply", "obj", "off", "stl", "xyz", "pcd", "las", "laz", "e57",
+    ];
     let mut checked = 0;
     for f in files {
         let ext = f
@@ -101,7 +103,11 @@ fn bad_input_corpus_gives_clear_errors() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../crease/tests/bad_input");
     let mut files = Vec::new();
     files_under(&dir, &mut files);
-    assert!(files.len() >= 20, "bad-input corpus too small: {}", files.len());
+    assert!(
+        files.len() >= 20,
+        "bad-input corpus too small: {}",
+        files.len()
+    );
     for f in files {
         let name = f.file_name().unwrap().to_string_lossy().into_owned();
         let nan = name.contains("nan");
@@ -118,7 +124,11 @@ fn bad_input_corpus_gives_clear_errors() {
         }
         let out = cmd.output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{name}: exit code, stderr {stderr}");
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{name}: exit code, stderr {stderr}"
+        );
         assert!(
             stderr.starts_with("error: ") && stderr.contains(&name),
             "{name}: message must name the file: {stderr}"
@@ -135,7 +145,10 @@ fn unknown_format_and_missing_file_are_errors() {
     let out = crease().arg("info").arg(&f).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     let e = String::from_utf8_lossy(&out.stderr);
-    assert!(e.contains("cloud.abc") && e.contains("unknown file format"), "{e}");
+    assert!(
+        e.contains("cloud.abc") && e.contains("unknown file format"),
+        "{e}"
+    );
 
     let out = crease()
         .arg("info")
@@ -161,7 +174,12 @@ fn convert_never_overwrites_its_input() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("never overwrites"));
     // The same file reached by another path.
     let other = tmp.path().join(".").join("pts.xyz");
-    let out = crease().arg("convert").arg(&f).arg(&other).output().unwrap();
+    let out = crease()
+        .arg("convert")
+        .arg(&f)
+        .arg(&other)
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(std::fs::read_to_string(&f).unwrap(), text);
 }
@@ -175,25 +193,52 @@ fn convert_round_trips_through_every_writable_format() {
         .arg(&src)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let info = |p: &Path| {
         let o = crease().args(["info", "--json"]).arg(p).output().unwrap();
-        assert!(o.status.success(), "{}: {}", p.display(), String::from_utf8_lossy(&o.stderr));
+        assert!(
+            o.status.success(),
+            "{}: {}",
+            p.display(),
+            String::from_utf8_lossy(&o.stderr)
+        );
         json_of(&o.stdout)
     };
     let base = info(&src);
     for ext in ["obj", "off", "stl", "ply"] {
         let dst = tmp.path().join(format!("converted.{ext}"));
-        let o = crease().arg("convert").arg(&src).arg(&dst).output().unwrap();
-        assert!(o.status.success(), "{ext}: {}", String::from_utf8_lossy(&o.stderr));
+        let o = crease()
+            .arg("convert")
+            .arg(&src)
+            .arg(&dst)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{ext}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         let v = info(&dst);
         assert_eq!(v["faces"], base["faces"], "{ext}");
         assert_eq!(v["points"], base["points"], "{ext}");
     }
     for ext in ["xyz", "pcd", "las", "laz", "e57"] {
         let dst = tmp.path().join(format!("converted.{ext}"));
-        let o = crease().arg("convert").arg(&src).arg(&dst).output().unwrap();
-        assert!(o.status.success(), "{ext}: {}", String::from_utf8_lossy(&o.stderr));
+        let o = crease()
+            .arg("convert")
+            .arg(&src)
+            .arg(&dst)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{ext}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         assert_eq!(info(&dst)["points"], base["points"], "{ext}");
     }
 }
@@ -212,7 +257,11 @@ fn synth_writes_exact_ground_truth() {
     assert_eq!(v["points"], 20000);
     assert!(tmp.path().join("cube.curves.ply").is_file());
     assert!(tmp.path().join("cube.truth.json").is_file());
-    let o = crease().args(["info", "--json"]).arg(&out_path).output().unwrap();
+    let o = crease()
+        .args(["info", "--json"])
+        .arg(&out_path)
+        .output()
+        .unwrap();
     let info = json_of(&o.stdout);
     let names: Vec<&str> = info["attributes"]
         .as_array()
@@ -220,7 +269,12 @@ fn synth_writes_exact_ground_truth() {
         .iter()
         .map(|a| a["name"].as_str().unwrap())
         .collect();
-    for want in ["gt_sharp", "gt_edge_distance", "gt_surface", "gt_surface_type"] {
+    for want in [
+        "gt_sharp",
+        "gt_edge_distance",
+        "gt_surface",
+        "gt_surface_type",
+    ] {
         assert!(names.contains(&want), "{want} missing from {names:?}");
     }
     // Six planes, all of surface type 0.
@@ -233,7 +287,11 @@ fn synth_writes_exact_ground_truth() {
     assert_eq!(st["histogram"].as_array().unwrap().len(), 1);
     assert!(info["normals"].as_bool().unwrap());
 
-    let o = crease().args(["synth", "no-such-shape", "-o"]).arg(&out_path).output().unwrap();
+    let o = crease()
+        .args(["synth", "no-such-shape", "-o"])
+        .arg(&out_path)
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("known shapes"));
 }
@@ -287,7 +345,11 @@ fn demo_writes_its_results() {
     let v = json_of(&o.stdout);
     for f in v["files"].as_array().unwrap() {
         let p = dir.join(f.as_str().unwrap());
-        assert!(p.is_file() && std::fs::metadata(&p).unwrap().len() > 0, "{}", p.display());
+        assert!(
+            p.is_file() && std::fs::metadata(&p).unwrap().len() > 0,
+            "{}",
+            p.display()
+        );
     }
     assert_eq!(v["points"], 20000);
     assert!(v["sharp_points"].as_u64().unwrap() > 0);

@@ -262,13 +262,13 @@ fn polygons_are_fan_triangulated_with_attributes_duplicated() {
                     }
                 }
                 for (corners, label, w) in [
-                    (vec![0, 1, 2, 3], 5i32, 0.5f32),
+                    (vec![0i32, 1, 2, 3], 5i32, 0.5f32),
                     (vec![1, 4, 2], 7, 0.25),
                     (vec![0, 1, 4, 5, 2], 9, 2.0),
                 ] {
                     b.push(corners.len() as u8);
                     for c in corners {
-                        b.extend_from_slice(&(c as i32).to_le_bytes());
+                        b.extend_from_slice(&c.to_le_bytes());
                     }
                     b.extend_from_slice(&label.to_le_bytes());
                     b.extend_from_slice(&w.to_le_bytes());

@@ -42,10 +42,10 @@ pub fn run(g: &Global, a: &SynthArgs) -> anyhow::Result<()> {
             a.outliers
         )));
     }
-    let noise = match (a.noise, a.noise_mode) {
-        (s, _) if s == 0.0 => Noise::None,
-        (s, NoiseMode::Normal) => Noise::AlongNormal(s),
-        (s, NoiseMode::Isotropic) => Noise::Isotropic(s),
+    let noise = match a.noise_mode {
+        _ if a.noise == 0.0 => Noise::None,
+        NoiseMode::Normal => Noise::AlongNormal(a.noise),
+        NoiseMode::Isotropic => Noise::Isotropic(a.noise),
     };
     let noise_scale = match a.noise_scale {
         NoiseScaleArg::Spacing => NoiseScale::Spacing,
@@ -61,7 +61,6 @@ pub fn run(g: &Global, a: &SynthArgs) -> anyhow::Result<()> {
                 noise_scale,
                 seed: a.seed,
                 sharp_tolerance: a.tolerance,
-                ..Default::default()
             },
         )?;
         let curves = m.curves_geometry();
