@@ -8,7 +8,6 @@ mod synth;
 
 use std::path::Path;
 
-use anyhow::Context;
 use crease::io::{Geometry, ReadOptions, ReadReport};
 
 use crate::args::{Cli, Command, Global};
@@ -56,8 +55,7 @@ pub fn save(
 ) -> anyhow::Result<()> {
     crate::ui::ensure_not_input(path, inputs)?;
     let stage = Stage::start(&format!("writing {}", path.display()), g.quiet);
-    crease::io::write(path, geom, &crease::io::WriteOptions { ascii })
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    crease::io::write(path, geom, &crease::io::WriteOptions { ascii })?;
     stage.finish();
     Ok(())
 }

@@ -146,13 +146,6 @@ fn data_hash(cloud: &PointCloud) -> u64 {
 
 /// Writes one E57 scan with f64 cartesian coordinates, colours and intensity.
 pub fn write(path: &Path, geom: &Geometry, _opts: &WriteOptions) -> Result<()> {
-    if geom.is_mesh() {
-        return Err(Error::Unsupported {
-            path: path.to_path_buf(),
-            message: "E57 holds point clouds only; the geometry has faces (write .ply or .obj)"
-                .into(),
-        });
-    }
     geom.validate()?;
     let cloud = &geom.points;
     let h = data_hash(cloud);

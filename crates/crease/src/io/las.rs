@@ -208,13 +208,6 @@ pub fn scale_for_diagonal(d: f64) -> f64 {
 
 /// Writes a LAS file, or LAZ when the extension is `.laz` (see the module documentation).
 pub fn write(path: &Path, geom: &Geometry, _opts: &WriteOptions) -> Result<()> {
-    if geom.is_mesh() {
-        return Err(Error::Unsupported {
-            path: path.to_path_buf(),
-            message: "LAS holds point clouds only; the geometry has faces (write .ply or .obj)"
-                .into(),
-        });
-    }
     geom.validate()?;
     let cloud = &geom.points;
     let n = cloud.len();

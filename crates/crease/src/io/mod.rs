@@ -278,8 +278,9 @@ pub fn read_mesh(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<(TriMesh,
 
 /// Writes `geom` in the format named by `path`'s extension.
 ///
-/// Formats that cannot hold part of the geometry say so in the error rather than dropping it
-/// silently (e.g. faces to `.xyz`), except per-point attributes a format has no room for.
+/// Point formats (XYZ, PCD, LAS, E57) write the points of any geometry: a mesh's vertices,
+/// without its faces, which is what converting a mesh to a point format means. Per-point data a
+/// format has no room for (e.g. arbitrary attributes in XYZ) is left out; PLY keeps everything.
 pub fn write(path: impl AsRef<Path>, geom: &Geometry, opts: &WriteOptions) -> Result<()> {
     let path = path.as_ref();
     geom.validate()?;

@@ -1053,13 +1053,6 @@ fn packed_rgb(c: [u8; 3]) -> u32 {
 
 /// Writes a PCD file: `DATA binary`, or `DATA ascii` with `opts.ascii`.
 pub fn write(path: &Path, geom: &Geometry, opts: &WriteOptions) -> Result<()> {
-    if geom.is_mesh() {
-        return Err(Error::Unsupported {
-            path: path.to_path_buf(),
-            message: "PCD holds point clouds only; the geometry has faces (write .ply or .obj)"
-                .into(),
-        });
-    }
     geom.validate()?;
     let cloud = &geom.points;
     let n = cloud.len();
