@@ -38,11 +38,17 @@ pub fn init_logging(verbose: u8, quiet: bool) {
     };
     let filter = tracing_subscriber::EnvFilter::try_from_default_env()
         .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(level));
-    let _ = tracing_subscriber::fmt()
+    let builder = tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
-        .with_target(false)
-        .try_init();
+        .with_ansi(std::io::stderr().is_terminal())
+        .with_target(false);
+    // Timestamps help when following a long run with -v; a plain warning needs none.
+    let _ = if verbose == 0 {
+        builder.without_time().try_init()
+    } else {
+        builder.try_init()
+    };
 }
 
 /// A spinner on stderr for one stage of work, shown only when stderr is a terminal (and not
