@@ -69,7 +69,11 @@ fn every_shared_data_file_loads_with_info() {
         );
         let v = json_of(&out.stdout);
         let points = v["points"].as_u64().unwrap_or(0);
-        let min = if v["faces"].as_u64().unwrap_or(0) > 0 { 8 } else { 1000 };
+        let min = if v["faces"].as_u64().unwrap_or(0) > 0 {
+            8
+        } else {
+            1000
+        };
         assert!(points >= min, "{}: only {points} points", f.display());
         assert!(
             v["spacing"].as_f64().unwrap_or(0.0) > 0.0,

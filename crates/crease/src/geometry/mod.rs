@@ -3,6 +3,7 @@
 mod aabb;
 mod attribute;
 pub mod cleanup;
+mod csr;
 mod mesh;
 mod point_cloud;
 pub(crate) use point_cloud::retain_by;
@@ -13,9 +14,10 @@ pub mod vec3;
 pub use aabb::Aabb;
 pub use attribute::{Attribute, Attributes, ScalarKind};
 pub use cleanup::{clean_mesh, CleanupParams, CleanupReport};
+pub use csr::Csr;
 pub use mesh::TriMesh;
 pub use point_cloud::{Point3, PointCloud};
 pub use spacing::{average_spacing, average_spacing_with};
 pub use topology::{
-    face_area, face_areas, face_normal, face_normals, Csr, MeshTopology, OneRing, VertexKind,
+    face_area, face_areas, face_normal, face_normals, MeshTopology, OneRing, VertexKind,
 };

@@ -18,61 +18,11 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use rayon::prelude::*;
 
-use super::{vec3, Point3, TriMesh};
+use super::{vec3, Csr, Point3, TriMesh};
 use crate::{Error, Result};
 
 /// Marks a face side that is not an edge (both corners are the same vertex).
 pub const NO_EDGE: u32 = u32::MAX;
-
-/// A compressed sparse row list: row `i` is `indices[offsets[i]..offsets[i + 1]]`.
-///
-/// `offsets` has `rows + 1` entries, starts at 0 and never decreases; `indices` has
-/// `offsets[rows]` entries.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Csr {
-    /// Row starts, `rows + 1` entries.
-    pub offsets: Vec<u32>,
-    /// Concatenated rows.
-    pub indices: Vec<u32>,
-}
-
-impl Csr {
-    /// Number of rows.
-    pub fn num_rows(&self) -> usize {
-        self.offsets.len().saturating_sub(1)
-    }
-
-    /// Row `i` (panics if `i >= num_rows()`).
-    #[inline]
-    pub fn row(&self, i: usize) -> &[u32] {
-        &self.indices[self.offsets[i] as usize..self.offsets[i + 1] as usize]
-    }
-
-    /// Length of row `i` (panics if `i >= num_rows()`).
-    #[inline]
-    pub fn row_len(&self, i: usize) -> usize {
-        (self.offsets[i + 1] - self.offsets[i]) as usize
-    }
-
-    /// The rows in order.
-    pub fn rows(&self) -> impl ExactSizeIterator<Item = &[u32]> + '_ {
-        self.offsets
-            .windows(2)
-            .map(move |w| &self.indices[w[0] as usize..w[1] as usize])
-    }
-
-    /// Offsets from per-row counts (prefix sum); the last entry is the total.
-    fn offsets_from_counts(counts: &[u32]) -> Vec<u32> {
-        let mut offsets = Vec::with_capacity(counts.len() + 1);
-        let mut acc = 0u32;
-        offsets.push(0);
-        for &c in counts {
-            acc += c;
-            offsets.push(acc);
-        }
-        offsets
-    }
-}
 
 /// What the faces around a vertex look like.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
