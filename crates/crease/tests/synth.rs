@@ -674,13 +674,7 @@ fn meshes_are_closed_manifolds_with_exact_features() {
         ("fillet-chamfer-cone", 2),
     ] {
         let shape = Shape::from_name(name).unwrap();
-        let m = match mesh(&shape, &MeshParams::default()) {
-            Ok(m) => m,
-            Err(e) => {
-                eprintln!("{name}: {e}");
-                continue;
-            }
-        };
+        let m = mesh(&shape, &MeshParams::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
         let tm = &m.mesh;
         tm.check_indices().unwrap();
         let ef = edge_faces(&tm.faces);
