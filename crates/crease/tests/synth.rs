@@ -849,3 +849,210 @@ fn timing_one_million_points() {
         );
     }
 }
+
+/// Triangle quality of a mesh: (min angle in degrees per face, edge lengths).
+fn quality(tm: &crease::geometry::TriMesh) -> (Vec<f64>, Vec<f64>) {
+    let p = tm.positions();
+    let mut angles = Vec::with_capacity(tm.num_faces());
+    let mut lengths = Vec::new();
+    for f in &tm.faces {
+        let v = f.map(|i| p[i as usize]);
+        let mut min = 180.0f64;
+        for k in 0..3 {
+            let a = sub(v[(k + 1) % 3], v[k]);
+            let b = sub(v[(k + 2) % 3], v[k]);
+            let c = (dot(a, b) / (norm(a) * norm(b))).clamp(-1.0, 1.0);
+            min = min.min(c.acos().to_degrees());
+            lengths.push(norm(a));
+        }
+        angles.push(min);
+    }
+    (angles, lengths)
+}
+
+/// Every vertex's faces form one closed fan (closed 2-manifold at the vertices too).
+fn vertex_fans_are_single_cycles(faces: &[[u32; 3]], nv: usize) -> bool {
+    let mut link: Vec<Vec<(u32, u32)>> = vec![Vec::new(); nv];
+    for f in faces {
+        for k in 0..3 {
+            link[f[k] as usize].push((f[(k + 1) % 3], f[(k + 2) % 3]));
+        }
+    }
+    link.iter().all(|l| {
+        if l.len() < 3 {
+            return false;
+        }
+        let next: HashMap<u32, u32> = l.iter().copied().collect();
+        if next.len() != l.len() {
+            return false;
+        }
+        let start = l[0].0;
+        let mut v = start;
+        for step in 1..=l.len() {
+            v = match next.get(&v) {
+                Some(&w) => w,
+                None => return false,
+            };
+            if v == start {
+                return step == l.len();
+            }
+        }
+        false
+    })
+}
+
+#[test]
+fn trimmed_meshes_quality_areas_and_determinism() {
+    for name in ["box-hole", "two-cylinders", "fillet-chamfer-cone"] {
+        let shape = Shape::from_name(name).unwrap();
+        let target = shape.aabb().max_side() / 40.0;
+        let m = mesh(&shape, &MeshParams::default()).unwrap();
+        let tm = &m.mesh;
+        assert!(
+            vertex_fans_are_single_cycles(&tm.faces, tm.num_vertices()),
+            "{name}: non-manifold vertex"
+        );
+        // No two vertices at the same place (seams and borders share their vertices).
+        let mut keys: Vec<[i64; 3]> = tm
+            .positions()
+            .iter()
+            .map(|p| p.map(|c| (c * 1e9).round() as i64))
+            .collect();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), tm.num_vertices(), "{name}: coincident vertices");
+        // Triangle quality and edge lengths.
+        let (angles, lengths) = quality(tm);
+        let min_angle = angles.iter().copied().fold(180.0, f64::min);
+        assert!(min_angle > 20.0, "{name}: min angle {min_angle}");
+        let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
+        assert!(
+            (0.9 * target..1.15 * target).contains(&mean),
+            "{name}: mean edge {mean} vs target {target}"
+        );
+        assert!((m.mean_edge - mean).abs() < 1e-3 * target);
+        let longest = lengths.iter().copied().fold(0.0, f64::max);
+        assert!(longest < 2.0 * target, "{name}: edge {longest}");
+        // Faces: exact outward normal agrees with the winding; per-surface areas match the
+        // exact trimmed areas (within the chord error of the curved borders).
+        let p = tm.positions();
+        let fsid = &tm.face_attributes.get("gt_surface").unwrap().values;
+        let ftype = &tm.face_attributes.get("gt_surface_type").unwrap().values;
+        let mut area = vec![0.0; m.surfaces.len()];
+        for (fi, f) in tm.faces.iter().enumerate() {
+            let s = &m.surfaces[fsid[fi] as usize];
+            assert_eq!(ftype[fi] as u8, s.kind.code());
+            let [a, b, c] = f.map(|i| p[i as usize]);
+            let (ab, ac) = (sub(b, a), sub(c, a));
+            let g = [
+                ab[1] * ac[2] - ab[2] * ac[1],
+                ab[2] * ac[0] - ab[0] * ac[2],
+                ab[0] * ac[1] - ab[1] * ac[0],
+            ];
+            area[fsid[fi] as usize] += norm(g) / 2.0;
+            let centre = [
+                (a[0] + b[0] + c[0]) / 3.0,
+                (a[1] + b[1] + c[1]) / 3.0,
+                (a[2] + b[2] + c[2]) / 3.0,
+            ];
+            let (_, grad) = implicit(&s.params, centre);
+            // implicit() gradients point outward (away from the axis for cylinders and cones,
+            // along the outward plane normal), except in the hole of the box.
+            let sign = match s.params {
+                SurfaceParams::Cylinder { .. } if name == "box-hole" => -1.0,
+                _ => 1.0,
+            };
+            assert!(
+                sign * dot(g, grad) > 0.0,
+                "{name}: face {fi} wound against its outward normal"
+            );
+        }
+        for (s, a) in m.surfaces.iter().zip(&area) {
+            assert!(
+                (a - s.area).abs() <= 0.01 * s.area,
+                "{name}: surface {} mesh area {a} vs {}",
+                s.id,
+                s.area
+            );
+        }
+        // Vertex normals: unit, exact normal of the vertex's surface.
+        let normals = tm.vertices.normals.as_ref().unwrap();
+        let vsid = &tm.vertices.attribute("gt_surface").unwrap().values;
+        for (i, (&q, &n)) in p.iter().zip(normals).enumerate() {
+            let s = &m.surfaces[vsid[i] as usize];
+            let (_, grad) = implicit(&s.params, q);
+            assert!((norm(n) - 1.0).abs() < 1e-12);
+            assert!(dot(n, grad).abs() > 1.0 - 1e-9, "{name}: vertex normal");
+        }
+        // Deterministic; noise moves the vertices only.
+        let again = mesh(&shape, &MeshParams::default()).unwrap();
+        assert_eq!(again.mesh, m.mesh, "{name}: not deterministic");
+        assert_eq!(again.sharp_edges, m.sharp_edges);
+        let noisy = mesh(
+            &shape,
+            &MeshParams {
+                noise: Noise::Isotropic(0.05),
+                seed: 9,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(noisy.mesh.faces, m.mesh.faces);
+        let moved = noisy
+            .mesh
+            .positions()
+            .iter()
+            .zip(p)
+            .map(|(a, b)| norm(sub(*a, *b)))
+            .collect::<Vec<_>>();
+        let rms = (moved.iter().map(|d| d * d).sum::<f64>() / moved.len() as f64).sqrt();
+        let want = 0.05 * m.mean_edge * 3f64.sqrt();
+        assert!(
+            (rms / want - 1.0).abs() < 0.1,
+            "{name}: noise rms {rms} vs {want}"
+        );
+        // A finer target gives proportionally more faces.
+        let fine = mesh(
+            &shape,
+            &MeshParams {
+                target_edge: Some(target / 2.0),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let ratio = fine.mesh.num_faces() as f64 / tm.num_faces() as f64;
+        assert!((3.5..4.5).contains(&ratio), "{name}: face ratio {ratio}");
+    }
+}
+
+/// Mesh timings at the default target and at ~1M triangles:
+/// `cargo test --release --test synth timing_meshes -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn timing_meshes_one_million_triangles() {
+    for &name in Shape::names() {
+        let shape = Shape::from_name(name).unwrap();
+        let t = std::time::Instant::now();
+        let m = mesh(&shape, &MeshParams::default()).unwrap();
+        let t0 = t.elapsed().as_secs_f64();
+        let target = shape.aabb().max_side() / 40.0 * (m.mesh.num_faces() as f64 / 1e6).sqrt();
+        let t = std::time::Instant::now();
+        let big = mesh(
+            &shape,
+            &MeshParams {
+                target_edge: Some(target),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let t1 = t.elapsed().as_secs_f64();
+        let min_angle = quality(&big.mesh).0.into_iter().fold(180.0, f64::min);
+        eprintln!(
+            "{name:>20}: default {} faces {:.3} s; {} faces {:.3} s (min angle {min_angle:.1}°)",
+            m.mesh.num_faces(),
+            t0,
+            big.mesh.num_faces(),
+            t1
+        );
+    }
+}
