@@ -674,106 +674,113 @@ fn meshes_are_closed_manifolds_with_exact_features() {
         ("fillet-chamfer-cone", 2),
     ] {
         let shape = Shape::from_name(name).unwrap();
-        let m = mesh(&shape, &MeshParams::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let tm = &m.mesh;
-        tm.check_indices().unwrap();
-        let ef = edge_faces(&tm.faces);
+        check_closed_mesh(name, &shape, &MeshParams::default(), euler);
+    }
+}
+
+/// The closed-solid mesh guarantees: every edge in exactly 2 faces, consistent outward
+/// orientation, Euler characteristic `euler`, vertices on their surfaces, feature edges on the
+/// feature curves and covering them (total length within 1 %).
+fn check_closed_mesh(name: &str, shape: &Shape, params: &MeshParams, euler: i64) {
+    let m = mesh(shape, params).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let tm = &m.mesh;
+    tm.check_indices().unwrap();
+    let ef = edge_faces(&tm.faces);
+    assert!(
+        ef.values().all(|&c| c == 2),
+        "{name}: edge not in exactly 2 faces"
+    );
+    // Consistent orientation: every directed edge appears once.
+    let mut directed = std::collections::HashSet::new();
+    for f in &tm.faces {
+        for k in 0..3 {
+            assert!(
+                directed.insert((f[k], f[(k + 1) % 3])),
+                "{name}: orientation"
+            );
+        }
+    }
+    let v = tm.num_vertices() as i64;
+    let e = ef.len() as i64;
+    let f = tm.num_faces() as i64;
+    assert_eq!(v - e + f, euler, "{name}: Euler characteristic");
+    // Outward orientation: positive signed volume.
+    let vol: f64 = tm
+        .faces
+        .iter()
+        .map(|&[a, b, c]| {
+            let p = tm.positions();
+            let (a, b, c) = (p[a as usize], p[b as usize], p[c as usize]);
+            dot(
+                a,
+                [
+                    b[1] * c[2] - b[2] * c[1],
+                    b[2] * c[0] - b[0] * c[2],
+                    b[0] * c[1] - b[1] * c[0],
+                ],
+            ) / 6.0
+        })
+        .sum();
+    assert!(vol > 0.0, "{name}: volume {vol}");
+    // Vertices on their surfaces.
+    let sid = &tm.vertices.attribute("gt_surface").unwrap().values;
+    for (i, &p) in tm.positions().iter().enumerate() {
+        let s = &m.surfaces[sid[i] as usize];
         assert!(
-            ef.values().all(|&c| c == 2),
-            "{name}: edge not in exactly 2 faces"
+            s.params.distance(p) < 1e-9,
+            "{name}: vertex off its surface"
         );
-        // Consistent orientation: every directed edge appears once.
-        let mut directed = std::collections::HashSet::new();
-        for f in &tm.faces {
-            for k in 0..3 {
-                assert!(
-                    directed.insert((f[k], f[(k + 1) % 3])),
-                    "{name}: orientation"
-                );
-            }
+    }
+    let fsid = &tm.face_attributes.get("gt_surface").unwrap().values;
+    assert_eq!(fsid.len(), tm.num_faces());
+    // Sharp / smooth edges: mesh edges whose endpoints and midpoint lie on a curve.
+    let size = shape.aabb().max_side();
+    for (edges, kind) in [
+        (&m.sharp_edges, CurveKind::Sharp),
+        (&m.smooth_edges, CurveKind::Smooth),
+    ] {
+        for &[a, b] in edges.iter() {
+            assert!(ef.contains_key(&(a.min(b), a.max(b))));
+            let pa = tm.positions()[a as usize];
+            let pb = tm.positions()[b as usize];
+            let on = |p: [f64; 3]| {
+                m.curves
+                    .iter()
+                    .filter(|c| c.kind == kind)
+                    .map(|c| c.distance(p))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            assert!(
+                on(pa) < 1e-9 && on(pb) < 1e-9,
+                "{name}: feature edge off curve"
+            );
+            let mid = [
+                (pa[0] + pb[0]) / 2.0,
+                (pa[1] + pb[1]) / 2.0,
+                (pa[2] + pb[2]) / 2.0,
+            ];
+            assert!(on(mid) < 1e-2 * size);
         }
-        let v = tm.num_vertices() as i64;
-        let e = ef.len() as i64;
-        let f = tm.num_faces() as i64;
-        assert_eq!(v - e + f, euler, "{name}: Euler characteristic");
-        // Outward orientation: positive signed volume.
-        let vol: f64 = tm
-            .faces
+    }
+    // The feature edges cover the feature curves: their total length ~ the curve length.
+    for (edges, kind) in [
+        (&m.sharp_edges, CurveKind::Sharp),
+        (&m.smooth_edges, CurveKind::Smooth),
+    ] {
+        let got: f64 = edges
             .iter()
-            .map(|&[a, b, c]| {
-                let p = tm.positions();
-                let (a, b, c) = (p[a as usize], p[b as usize], p[c as usize]);
-                dot(
-                    a,
-                    [
-                        b[1] * c[2] - b[2] * c[1],
-                        b[2] * c[0] - b[0] * c[2],
-                        b[0] * c[1] - b[1] * c[0],
-                    ],
-                ) / 6.0
-            })
+            .map(|&[a, b]| norm(sub(tm.positions()[a as usize], tm.positions()[b as usize])))
             .sum();
-        assert!(vol > 0.0, "{name}: volume {vol}");
-        // Vertices on their surfaces.
-        let sid = &tm.vertices.attribute("gt_surface").unwrap().values;
-        for (i, &p) in tm.positions().iter().enumerate() {
-            let s = &m.surfaces[sid[i] as usize];
-            assert!(
-                s.params.distance(p) < 1e-9,
-                "{name}: vertex off its surface"
-            );
-        }
-        let fsid = &tm.face_attributes.get("gt_surface").unwrap().values;
-        assert_eq!(fsid.len(), tm.num_faces());
-        // Sharp / smooth edges: mesh edges whose endpoints and midpoint lie on a curve.
-        let size = shape.aabb().max_side();
-        for (edges, kind) in [
-            (&m.sharp_edges, CurveKind::Sharp),
-            (&m.smooth_edges, CurveKind::Smooth),
-        ] {
-            for &[a, b] in edges.iter() {
-                assert!(ef.contains_key(&(a.min(b), a.max(b))));
-                let pa = tm.positions()[a as usize];
-                let pb = tm.positions()[b as usize];
-                let on = |p: [f64; 3]| {
-                    m.curves
-                        .iter()
-                        .filter(|c| c.kind == kind)
-                        .map(|c| c.distance(p))
-                        .fold(f64::INFINITY, f64::min)
-                };
-                assert!(
-                    on(pa) < 1e-9 && on(pb) < 1e-9,
-                    "{name}: feature edge off curve"
-                );
-                let mid = [
-                    (pa[0] + pb[0]) / 2.0,
-                    (pa[1] + pb[1]) / 2.0,
-                    (pa[2] + pb[2]) / 2.0,
-                ];
-                assert!(on(mid) < 1e-2 * size);
-            }
-        }
-        // The feature edges cover the feature curves: their total length ~ the curve length.
-        for (edges, kind) in [
-            (&m.sharp_edges, CurveKind::Sharp),
-            (&m.smooth_edges, CurveKind::Smooth),
-        ] {
-            let got: f64 = edges
-                .iter()
-                .map(|&[a, b]| norm(sub(tm.positions()[a as usize], tm.positions()[b as usize])))
-                .sum();
-            let want: f64 = m
-                .curves
-                .iter()
-                .filter(|c| c.kind == kind)
-                .map(|c| c.length)
-                .sum();
-            assert!(
-                (got - want).abs() <= 0.01 * want + 1e-12,
-                "{name} {kind:?}: feature edges {got} vs curves {want}"
-            );
-        }
+        let want: f64 = m
+            .curves
+            .iter()
+            .filter(|c| c.kind == kind)
+            .map(|c| c.length)
+            .sum();
+        assert!(
+            (got - want).abs() <= 0.01 * want + 1e-12,
+            "{name} {kind:?}: feature edges {got} vs curves {want}"
+        );
     }
 }
 
@@ -781,9 +788,7 @@ fn meshes_are_closed_manifolds_with_exact_features() {
 fn mesh_noise_and_open_primitives() {
     for name in ["plane", "cylinder", "cone"] {
         let shape = Shape::from_name(name).unwrap();
-        let Ok(m) = mesh(&shape, &MeshParams::default()) else {
-            continue;
-        };
+        let m = mesh(&shape, &MeshParams::default()).unwrap();
         let ef = edge_faces(&m.mesh.faces);
         assert!(ef.values().all(|&c| c == 1 || c == 2));
         let boundary = ef.values().filter(|&&c| c == 1).count();
@@ -793,6 +798,31 @@ fn mesh_noise_and_open_primitives() {
         let f = m.mesh.num_faces() as i64;
         let euler = if name == "plane" { 1 } else { 0 };
         assert_eq!(v - e + f, euler, "{name}");
+        // Vertices on the surface; the open boundary runs along the boundary curves.
+        let p = m.mesh.positions();
+        assert!(p.iter().all(|&q| m.surfaces[0].params.distance(q) < 1e-9));
+        let on = |q: [f64; 3]| {
+            m.curves
+                .iter()
+                .map(|c| c.distance(q))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut got = 0.0;
+        for (&(a, b), &c) in &ef {
+            if c == 1 {
+                let (pa, pb) = (p[a as usize], p[b as usize]);
+                assert!(
+                    on(pa) < 1e-9 && on(pb) < 1e-9,
+                    "{name}: boundary vertex off curve"
+                );
+                got += norm(sub(pa, pb));
+            }
+        }
+        let want: f64 = m.curves.iter().map(|c| c.length).sum();
+        assert!(
+            (got - want).abs() <= 0.01 * want,
+            "{name}: boundary {got} vs {want}"
+        );
     }
     let shape = Shape::default_cube();
     let clean = mesh(&shape, &MeshParams::default()).unwrap();
@@ -1022,6 +1052,60 @@ fn trimmed_meshes_quality_areas_and_determinism() {
         .unwrap();
         let ratio = fine.mesh.num_faces() as f64 / tm.num_faces() as f64;
         assert!((3.5..4.5).contains(&ratio), "{name}: face ratio {ratio}");
+    }
+}
+
+#[test]
+fn trimmed_meshes_are_closed_over_targets_and_dimensions() {
+    let variants = [
+        (Shape::from_name("box-hole").unwrap(), 0),
+        (
+            Shape::BoxWithHole {
+                size: [2.0, 0.6, 0.3],
+                hole_radius: 0.29,
+            },
+            0,
+        ),
+        (Shape::from_name("two-cylinders").unwrap(), 2),
+        (
+            Shape::TwoCylinders {
+                radius_a: 0.5,
+                half_length_a: 0.6,
+                radius_b: 0.45,
+                half_length_b: 0.8,
+            },
+            2,
+        ),
+        (Shape::from_name("fillet-chamfer-cone").unwrap(), 2),
+        (
+            Shape::FilletChamferCone {
+                length: 1.0,
+                width: 1.0,
+                height: 0.3,
+                fillet_radius: 0.25,
+                chamfer: 0.05,
+                cone_base_radius: 0.3,
+                cone_top_radius: 0.02,
+                cone_height: 0.6,
+            },
+            2,
+        ),
+    ];
+    for (shape, euler) in variants {
+        let size = shape.aabb().max_side();
+        for div in [6.0, 13.0, 31.0, 90.0] {
+            let params = MeshParams {
+                target_edge: Some(size / div),
+                ..Default::default()
+            };
+            let name = format!("{} ({shape:?}) at size/{div}", shape.name());
+            check_closed_mesh(&name, &shape, &params, euler);
+            let m = mesh(&shape, &params).unwrap();
+            assert!(
+                vertex_fans_are_single_cycles(&m.mesh.faces, m.mesh.num_vertices()),
+                "{name}: non-manifold vertex"
+            );
+        }
     }
 }
 

@@ -549,6 +549,16 @@ fn join(parts: &[Vec<u32>]) -> Result<Vec<u32>> {
     Ok(out)
 }
 
+/// The loop of a closed chain (whose last vertex repeats the first).
+fn closed_loop(c: &[u32]) -> Result<Vec<u32>> {
+    match c.split_last() {
+        Some((last, rest)) if rest.len() >= 3 && rest.first() == Some(last) => Ok(rest.to_vec()),
+        _ => Err(Error::InvalidInput(
+            "synthetic mesh: closed curve chain does not return to its start".into(),
+        )),
+    }
+}
+
 /// Appends the points of a hexagonal lattice of spacing `t` over the bounding box of the
 /// boundary points `pts[..]` that are at least `MARGIN · t` from every boundary segment.
 fn lattice(pts: &mut Vec<Point2<f64>>, edges: &[[usize; 2]], t: f64) {
@@ -685,7 +695,7 @@ fn box_with_hole(net: &mut Net, size: [f64; 3], r: f64) -> Result<()> {
     let at = |key: [usize; 3]| corner[&key];
     // The 12 edges: along axis k, at the other two axes' sides.
     for k in 0..3 {
-        for a in 0..2 {
+        for (a, &sa) in signs.iter().enumerate() {
             for b in 0..2 {
                 let (i, j) = ((k + 1) % 3, (k + 2) % 3);
                 let mut lo = [0; 3];
@@ -693,7 +703,7 @@ fn box_with_hole(net: &mut Net, size: [f64; 3], r: f64) -> Result<()> {
                 lo[j] = b;
                 let mut hi = lo;
                 hi[k] = 1;
-                net.segment(at(lo), at(hi), face(i, signs[a]))?;
+                net.segment(at(lo), at(hi), face(i, sa))?;
             }
         }
     }
@@ -717,7 +727,7 @@ fn box_with_hole(net: &mut Net, size: [f64; 3], r: f64) -> Result<()> {
             let mut loops = vec![outer];
             if k == 2 {
                 let hole = if side == 0 { &bottom } else { &top };
-                loops.push(join(&[hole.clone()])?);
+                loops.push(closed_loop(hole)?);
             }
             net.patch(face(k, s), &loops)?;
         }
@@ -783,7 +793,7 @@ fn two_cylinders(net: &mut Net, ra: f64, ha: f64, rb: f64, hb: f64) -> Result<()
         let seam = net.between(c[0], cap[0])?;
         let outer = join(&[c.clone(), seam.clone(), rev(&cap), rev(&seam)])?;
         net.patch(side, &[outer])?;
-        net.patch(5 + i as u32, &[join(&[cap])?])?;
+        net.patch(5 + i as u32, &[closed_loop(&cap)?])?;
         b_caps.push(c);
     }
     let outer = join(&[
@@ -794,14 +804,10 @@ fn two_cylinders(net: &mut Net, ra: f64, ha: f64, rb: f64, hb: f64) -> Result<()
     ])?;
     net.patch(
         0,
-        &[
-            outer,
-            join(&[b_caps[0].clone()])?,
-            join(&[b_caps[1].clone()])?,
-        ],
+        &[outer, closed_loop(&b_caps[0])?, closed_loop(&b_caps[1])?],
     )?;
     for (i, cap) in a_caps.into_iter().enumerate() {
-        net.patch(1 + i as u32, &[join(&[cap])?])?;
+        net.patch(1 + i as u32, &[closed_loop(&cap)?])?;
     }
     Ok(())
 }
@@ -887,7 +893,7 @@ fn fillet_chamfer_cone(
     let bottom = lp(net, &[e0.b_minus, e1.b_minus, e1.b_plus, e0.b_plus])?;
     net.patch(0, &[bottom])?;
     let top_face = lp(net, &[e0.p[2], e1.p[2], e1.p[1], e0.p[1]])?;
-    net.patch(1, &[top_face, join(&[base.clone()])?])?;
+    net.patch(1, &[top_face, closed_loop(&base)?])?;
     let side_plus = lp(net, &[e0.b_plus, e1.b_plus, e1.p[0], e0.p[0]])?;
     net.patch(2, &[side_plus])?;
     let side_minus = lp(net, &[e0.b_minus, e1.b_minus, e1.p[3], e0.p[3]])?;
@@ -902,6 +908,6 @@ fn fillet_chamfer_cone(
     net.patch(7, &[chamfer])?;
     let cone = join(&[base.clone(), seam.clone(), rev(&top), rev(&seam)])?;
     net.patch(8, &[cone])?;
-    net.patch(9, &[join(&[top])?])?;
+    net.patch(9, &[closed_loop(&top)?])?;
     Ok(())
 }
