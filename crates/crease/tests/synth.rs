@@ -674,112 +674,113 @@ fn meshes_are_closed_manifolds_with_exact_features() {
         ("fillet-chamfer-cone", 2),
     ] {
         let shape = Shape::from_name(name).unwrap();
-        let m = match mesh(&shape, &MeshParams::default()) {
-            Ok(m) => m,
-            Err(e) => {
-                eprintln!("{name}: {e}");
-                continue;
-            }
-        };
-        let tm = &m.mesh;
-        tm.check_indices().unwrap();
-        let ef = edge_faces(&tm.faces);
+        check_closed_mesh(name, &shape, &MeshParams::default(), euler);
+    }
+}
+
+/// The closed-solid mesh guarantees: every edge in exactly 2 faces, consistent outward
+/// orientation, Euler characteristic `euler`, vertices on their surfaces, feature edges on the
+/// feature curves and covering them (total length within 1 %).
+fn check_closed_mesh(name: &str, shape: &Shape, params: &MeshParams, euler: i64) {
+    let m = mesh(shape, params).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let tm = &m.mesh;
+    tm.check_indices().unwrap();
+    let ef = edge_faces(&tm.faces);
+    assert!(
+        ef.values().all(|&c| c == 2),
+        "{name}: edge not in exactly 2 faces"
+    );
+    // Consistent orientation: every directed edge appears once.
+    let mut directed = std::collections::HashSet::new();
+    for f in &tm.faces {
+        for k in 0..3 {
+            assert!(
+                directed.insert((f[k], f[(k + 1) % 3])),
+                "{name}: orientation"
+            );
+        }
+    }
+    let v = tm.num_vertices() as i64;
+    let e = ef.len() as i64;
+    let f = tm.num_faces() as i64;
+    assert_eq!(v - e + f, euler, "{name}: Euler characteristic");
+    // Outward orientation: positive signed volume.
+    let vol: f64 = tm
+        .faces
+        .iter()
+        .map(|&[a, b, c]| {
+            let p = tm.positions();
+            let (a, b, c) = (p[a as usize], p[b as usize], p[c as usize]);
+            dot(
+                a,
+                [
+                    b[1] * c[2] - b[2] * c[1],
+                    b[2] * c[0] - b[0] * c[2],
+                    b[0] * c[1] - b[1] * c[0],
+                ],
+            ) / 6.0
+        })
+        .sum();
+    assert!(vol > 0.0, "{name}: volume {vol}");
+    // Vertices on their surfaces.
+    let sid = &tm.vertices.attribute("gt_surface").unwrap().values;
+    for (i, &p) in tm.positions().iter().enumerate() {
+        let s = &m.surfaces[sid[i] as usize];
         assert!(
-            ef.values().all(|&c| c == 2),
-            "{name}: edge not in exactly 2 faces"
+            s.params.distance(p) < 1e-9,
+            "{name}: vertex off its surface"
         );
-        // Consistent orientation: every directed edge appears once.
-        let mut directed = std::collections::HashSet::new();
-        for f in &tm.faces {
-            for k in 0..3 {
-                assert!(
-                    directed.insert((f[k], f[(k + 1) % 3])),
-                    "{name}: orientation"
-                );
-            }
+    }
+    let fsid = &tm.face_attributes.get("gt_surface").unwrap().values;
+    assert_eq!(fsid.len(), tm.num_faces());
+    // Sharp / smooth edges: mesh edges whose endpoints and midpoint lie on a curve.
+    let size = shape.aabb().max_side();
+    for (edges, kind) in [
+        (&m.sharp_edges, CurveKind::Sharp),
+        (&m.smooth_edges, CurveKind::Smooth),
+    ] {
+        for &[a, b] in edges.iter() {
+            assert!(ef.contains_key(&(a.min(b), a.max(b))));
+            let pa = tm.positions()[a as usize];
+            let pb = tm.positions()[b as usize];
+            let on = |p: [f64; 3]| {
+                m.curves
+                    .iter()
+                    .filter(|c| c.kind == kind)
+                    .map(|c| c.distance(p))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            assert!(
+                on(pa) < 1e-9 && on(pb) < 1e-9,
+                "{name}: feature edge off curve"
+            );
+            let mid = [
+                (pa[0] + pb[0]) / 2.0,
+                (pa[1] + pb[1]) / 2.0,
+                (pa[2] + pb[2]) / 2.0,
+            ];
+            assert!(on(mid) < 1e-2 * size);
         }
-        let v = tm.num_vertices() as i64;
-        let e = ef.len() as i64;
-        let f = tm.num_faces() as i64;
-        assert_eq!(v - e + f, euler, "{name}: Euler characteristic");
-        // Outward orientation: positive signed volume.
-        let vol: f64 = tm
-            .faces
+    }
+    // The feature edges cover the feature curves: their total length ~ the curve length.
+    for (edges, kind) in [
+        (&m.sharp_edges, CurveKind::Sharp),
+        (&m.smooth_edges, CurveKind::Smooth),
+    ] {
+        let got: f64 = edges
             .iter()
-            .map(|&[a, b, c]| {
-                let p = tm.positions();
-                let (a, b, c) = (p[a as usize], p[b as usize], p[c as usize]);
-                dot(
-                    a,
-                    [
-                        b[1] * c[2] - b[2] * c[1],
-                        b[2] * c[0] - b[0] * c[2],
-                        b[0] * c[1] - b[1] * c[0],
-                    ],
-                ) / 6.0
-            })
+            .map(|&[a, b]| norm(sub(tm.positions()[a as usize], tm.positions()[b as usize])))
             .sum();
-        assert!(vol > 0.0, "{name}: volume {vol}");
-        // Vertices on their surfaces.
-        let sid = &tm.vertices.attribute("gt_surface").unwrap().values;
-        for (i, &p) in tm.positions().iter().enumerate() {
-            let s = &m.surfaces[sid[i] as usize];
-            assert!(
-                s.params.distance(p) < 1e-9,
-                "{name}: vertex off its surface"
-            );
-        }
-        let fsid = &tm.face_attributes.get("gt_surface").unwrap().values;
-        assert_eq!(fsid.len(), tm.num_faces());
-        // Sharp / smooth edges: mesh edges whose endpoints and midpoint lie on a curve.
-        let size = shape.aabb().max_side();
-        for (edges, kind) in [
-            (&m.sharp_edges, CurveKind::Sharp),
-            (&m.smooth_edges, CurveKind::Smooth),
-        ] {
-            for &[a, b] in edges.iter() {
-                assert!(ef.contains_key(&(a.min(b), a.max(b))));
-                let pa = tm.positions()[a as usize];
-                let pb = tm.positions()[b as usize];
-                let on = |p: [f64; 3]| {
-                    m.curves
-                        .iter()
-                        .filter(|c| c.kind == kind)
-                        .map(|c| c.distance(p))
-                        .fold(f64::INFINITY, f64::min)
-                };
-                assert!(
-                    on(pa) < 1e-9 && on(pb) < 1e-9,
-                    "{name}: feature edge off curve"
-                );
-                let mid = [
-                    (pa[0] + pb[0]) / 2.0,
-                    (pa[1] + pb[1]) / 2.0,
-                    (pa[2] + pb[2]) / 2.0,
-                ];
-                assert!(on(mid) < 1e-2 * size);
-            }
-        }
-        // The feature edges cover the feature curves: their total length ~ the curve length.
-        for (edges, kind) in [
-            (&m.sharp_edges, CurveKind::Sharp),
-            (&m.smooth_edges, CurveKind::Smooth),
-        ] {
-            let got: f64 = edges
-                .iter()
-                .map(|&[a, b]| norm(sub(tm.positions()[a as usize], tm.positions()[b as usize])))
-                .sum();
-            let want: f64 = m
-                .curves
-                .iter()
-                .filter(|c| c.kind == kind)
-                .map(|c| c.length)
-                .sum();
-            assert!(
-                (got - want).abs() <= 0.01 * want + 1e-12,
-                "{name} {kind:?}: feature edges {got} vs curves {want}"
-            );
-        }
+        let want: f64 = m
+            .curves
+            .iter()
+            .filter(|c| c.kind == kind)
+            .map(|c| c.length)
+            .sum();
+        assert!(
+            (got - want).abs() <= 0.01 * want + 1e-12,
+            "{name} {kind:?}: feature edges {got} vs curves {want}"
+        );
     }
 }
 
@@ -787,9 +788,7 @@ fn meshes_are_closed_manifolds_with_exact_features() {
 fn mesh_noise_and_open_primitives() {
     for name in ["plane", "cylinder", "cone"] {
         let shape = Shape::from_name(name).unwrap();
-        let Ok(m) = mesh(&shape, &MeshParams::default()) else {
-            continue;
-        };
+        let m = mesh(&shape, &MeshParams::default()).unwrap();
         let ef = edge_faces(&m.mesh.faces);
         assert!(ef.values().all(|&c| c == 1 || c == 2));
         let boundary = ef.values().filter(|&&c| c == 1).count();
@@ -799,6 +798,31 @@ fn mesh_noise_and_open_primitives() {
         let f = m.mesh.num_faces() as i64;
         let euler = if name == "plane" { 1 } else { 0 };
         assert_eq!(v - e + f, euler, "{name}");
+        // Vertices on the surface; the open boundary runs along the boundary curves.
+        let p = m.mesh.positions();
+        assert!(p.iter().all(|&q| m.surfaces[0].params.distance(q) < 1e-9));
+        let on = |q: [f64; 3]| {
+            m.curves
+                .iter()
+                .map(|c| c.distance(q))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut got = 0.0;
+        for (&(a, b), &c) in &ef {
+            if c == 1 {
+                let (pa, pb) = (p[a as usize], p[b as usize]);
+                assert!(
+                    on(pa) < 1e-9 && on(pb) < 1e-9,
+                    "{name}: boundary vertex off curve"
+                );
+                got += norm(sub(pa, pb));
+            }
+        }
+        let want: f64 = m.curves.iter().map(|c| c.length).sum();
+        assert!(
+            (got - want).abs() <= 0.01 * want,
+            "{name}: boundary {got} vs {want}"
+        );
     }
     let shape = Shape::default_cube();
     let clean = mesh(&shape, &MeshParams::default()).unwrap();
@@ -852,6 +876,267 @@ fn timing_one_million_points() {
             t.elapsed().as_secs_f64(),
             part.surfaces.len(),
             part.curves.len()
+        );
+    }
+}
+
+/// Triangle quality of a mesh: (min angle in degrees per face, edge lengths).
+fn quality(tm: &crease::geometry::TriMesh) -> (Vec<f64>, Vec<f64>) {
+    let p = tm.positions();
+    let mut angles = Vec::with_capacity(tm.num_faces());
+    let mut lengths = Vec::new();
+    for f in &tm.faces {
+        let v = f.map(|i| p[i as usize]);
+        let mut min = 180.0f64;
+        for k in 0..3 {
+            let a = sub(v[(k + 1) % 3], v[k]);
+            let b = sub(v[(k + 2) % 3], v[k]);
+            let c = (dot(a, b) / (norm(a) * norm(b))).clamp(-1.0, 1.0);
+            min = min.min(c.acos().to_degrees());
+            lengths.push(norm(a));
+        }
+        angles.push(min);
+    }
+    (angles, lengths)
+}
+
+/// Every vertex's faces form one closed fan (closed 2-manifold at the vertices too).
+fn vertex_fans_are_single_cycles(faces: &[[u32; 3]], nv: usize) -> bool {
+    let mut link: Vec<Vec<(u32, u32)>> = vec![Vec::new(); nv];
+    for f in faces {
+        for k in 0..3 {
+            link[f[k] as usize].push((f[(k + 1) % 3], f[(k + 2) % 3]));
+        }
+    }
+    link.iter().all(|l| {
+        if l.len() < 3 {
+            return false;
+        }
+        let next: HashMap<u32, u32> = l.iter().copied().collect();
+        if next.len() != l.len() {
+            return false;
+        }
+        let start = l[0].0;
+        let mut v = start;
+        for step in 1..=l.len() {
+            v = match next.get(&v) {
+                Some(&w) => w,
+                None => return false,
+            };
+            if v == start {
+                return step == l.len();
+            }
+        }
+        false
+    })
+}
+
+#[test]
+fn trimmed_meshes_quality_areas_and_determinism() {
+    for name in ["box-hole", "two-cylinders", "fillet-chamfer-cone"] {
+        let shape = Shape::from_name(name).unwrap();
+        let target = shape.aabb().max_side() / 40.0;
+        let m = mesh(&shape, &MeshParams::default()).unwrap();
+        let tm = &m.mesh;
+        assert!(
+            vertex_fans_are_single_cycles(&tm.faces, tm.num_vertices()),
+            "{name}: non-manifold vertex"
+        );
+        // No two vertices at the same place (seams and borders share their vertices).
+        let mut keys: Vec<[i64; 3]> = tm
+            .positions()
+            .iter()
+            .map(|p| p.map(|c| (c * 1e9).round() as i64))
+            .collect();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), tm.num_vertices(), "{name}: coincident vertices");
+        // Triangle quality and edge lengths.
+        let (angles, lengths) = quality(tm);
+        let min_angle = angles.iter().copied().fold(180.0, f64::min);
+        assert!(min_angle > 20.0, "{name}: min angle {min_angle}");
+        let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
+        assert!(
+            (0.9 * target..1.15 * target).contains(&mean),
+            "{name}: mean edge {mean} vs target {target}"
+        );
+        assert!((m.mean_edge - mean).abs() < 1e-3 * target);
+        let longest = lengths.iter().copied().fold(0.0, f64::max);
+        assert!(longest < 2.0 * target, "{name}: edge {longest}");
+        // Faces: exact outward normal agrees with the winding; per-surface areas match the
+        // exact trimmed areas (within the chord error of the curved borders).
+        let p = tm.positions();
+        let fsid = &tm.face_attributes.get("gt_surface").unwrap().values;
+        let ftype = &tm.face_attributes.get("gt_surface_type").unwrap().values;
+        let mut area = vec![0.0; m.surfaces.len()];
+        for (fi, f) in tm.faces.iter().enumerate() {
+            let s = &m.surfaces[fsid[fi] as usize];
+            assert_eq!(ftype[fi] as u8, s.kind.code());
+            let [a, b, c] = f.map(|i| p[i as usize]);
+            let (ab, ac) = (sub(b, a), sub(c, a));
+            let g = [
+                ab[1] * ac[2] - ab[2] * ac[1],
+                ab[2] * ac[0] - ab[0] * ac[2],
+                ab[0] * ac[1] - ab[1] * ac[0],
+            ];
+            area[fsid[fi] as usize] += norm(g) / 2.0;
+            let centre = [
+                (a[0] + b[0] + c[0]) / 3.0,
+                (a[1] + b[1] + c[1]) / 3.0,
+                (a[2] + b[2] + c[2]) / 3.0,
+            ];
+            let (_, grad) = implicit(&s.params, centre);
+            // implicit() gradients point outward (away from the axis for cylinders and cones,
+            // along the outward plane normal), except in the hole of the box.
+            let sign = match s.params {
+                SurfaceParams::Cylinder { .. } if name == "box-hole" => -1.0,
+                _ => 1.0,
+            };
+            assert!(
+                sign * dot(g, grad) > 0.0,
+                "{name}: face {fi} wound against its outward normal"
+            );
+        }
+        for (s, a) in m.surfaces.iter().zip(&area) {
+            assert!(
+                (a - s.area).abs() <= 0.01 * s.area,
+                "{name}: surface {} mesh area {a} vs {}",
+                s.id,
+                s.area
+            );
+        }
+        // Vertex normals: unit, exact normal of the vertex's surface.
+        let normals = tm.vertices.normals.as_ref().unwrap();
+        let vsid = &tm.vertices.attribute("gt_surface").unwrap().values;
+        for (i, (&q, &n)) in p.iter().zip(normals).enumerate() {
+            let s = &m.surfaces[vsid[i] as usize];
+            let (_, grad) = implicit(&s.params, q);
+            assert!((norm(n) - 1.0).abs() < 1e-12);
+            assert!(dot(n, grad).abs() > 1.0 - 1e-9, "{name}: vertex normal");
+        }
+        // Deterministic; noise moves the vertices only.
+        let again = mesh(&shape, &MeshParams::default()).unwrap();
+        assert_eq!(again.mesh, m.mesh, "{name}: not deterministic");
+        assert_eq!(again.sharp_edges, m.sharp_edges);
+        let noisy = mesh(
+            &shape,
+            &MeshParams {
+                noise: Noise::Isotropic(0.05),
+                seed: 9,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(noisy.mesh.faces, m.mesh.faces);
+        let moved = noisy
+            .mesh
+            .positions()
+            .iter()
+            .zip(p)
+            .map(|(a, b)| norm(sub(*a, *b)))
+            .collect::<Vec<_>>();
+        let rms = (moved.iter().map(|d| d * d).sum::<f64>() / moved.len() as f64).sqrt();
+        let want = 0.05 * m.mean_edge * 3f64.sqrt();
+        assert!(
+            (rms / want - 1.0).abs() < 0.1,
+            "{name}: noise rms {rms} vs {want}"
+        );
+        // A finer target gives proportionally more faces.
+        let fine = mesh(
+            &shape,
+            &MeshParams {
+                target_edge: Some(target / 2.0),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let ratio = fine.mesh.num_faces() as f64 / tm.num_faces() as f64;
+        assert!((3.5..4.5).contains(&ratio), "{name}: face ratio {ratio}");
+    }
+}
+
+#[test]
+fn trimmed_meshes_are_closed_over_targets_and_dimensions() {
+    let variants = [
+        (Shape::from_name("box-hole").unwrap(), 0),
+        (
+            Shape::BoxWithHole {
+                size: [2.0, 0.6, 0.3],
+                hole_radius: 0.29,
+            },
+            0,
+        ),
+        (Shape::from_name("two-cylinders").unwrap(), 2),
+        (
+            Shape::TwoCylinders {
+                radius_a: 0.5,
+                half_length_a: 0.6,
+                radius_b: 0.45,
+                half_length_b: 0.8,
+            },
+            2,
+        ),
+        (Shape::from_name("fillet-chamfer-cone").unwrap(), 2),
+        (
+            Shape::FilletChamferCone {
+                length: 1.0,
+                width: 1.0,
+                height: 0.3,
+                fillet_radius: 0.25,
+                chamfer: 0.05,
+                cone_base_radius: 0.3,
+                cone_top_radius: 0.02,
+                cone_height: 0.6,
+            },
+            2,
+        ),
+    ];
+    for (shape, euler) in variants {
+        let size = shape.aabb().max_side();
+        for div in [6.0, 13.0, 31.0, 90.0] {
+            let params = MeshParams {
+                target_edge: Some(size / div),
+                ..Default::default()
+            };
+            let name = format!("{} ({shape:?}) at size/{div}", shape.name());
+            check_closed_mesh(&name, &shape, &params, euler);
+            let m = mesh(&shape, &params).unwrap();
+            assert!(
+                vertex_fans_are_single_cycles(&m.mesh.faces, m.mesh.num_vertices()),
+                "{name}: non-manifold vertex"
+            );
+        }
+    }
+}
+
+/// Mesh timings at the default target and at ~1M triangles:
+/// `cargo test --release --test synth timing_meshes -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn timing_meshes_one_million_triangles() {
+    for &name in Shape::names() {
+        let shape = Shape::from_name(name).unwrap();
+        let t = std::time::Instant::now();
+        let m = mesh(&shape, &MeshParams::default()).unwrap();
+        let t0 = t.elapsed().as_secs_f64();
+        let target = shape.aabb().max_side() / 40.0 * (m.mesh.num_faces() as f64 / 1e6).sqrt();
+        let t = std::time::Instant::now();
+        let big = mesh(
+            &shape,
+            &MeshParams {
+                target_edge: Some(target),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let t1 = t.elapsed().as_secs_f64();
+        let min_angle = quality(&big.mesh).0.into_iter().fold(180.0, f64::min);
+        eprintln!(
+            "{name:>20}: default {} faces {:.3} s; {} faces {:.3} s (min angle {min_angle:.1}°)",
+            m.mesh.num_faces(),
+            t0,
+            big.mesh.num_faces(),
+            t1
         );
     }
 }

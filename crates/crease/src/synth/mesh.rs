@@ -8,7 +8,8 @@
 //! torus and the open primitives (plane, cylinder, cone) use their (angle, angle) or
 //! (angle, height) grids. Shared vertices are identified by their integer grid keys, so the
 //! solids are watertight by construction. The box with a hole, the two cylinders and the
-//! fillet-chamfer-cone block need trimmed-domain triangulations and return an error for now.
+//! fillet-chamfer-cone block are triangulated patch by patch in their parameter domains
+//! (constrained Delaunay triangulation of the trimmed domain, see `trimmed.rs`).
 
 use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_4, TAU};
@@ -161,30 +162,26 @@ pub fn mesh(shape: &Shape, p: &MeshParams) -> Result<SyntheticMesh> {
         }
         Shape::BoxWithHole { .. }
         | Shape::TwoCylinders { .. }
-        | Shape::FilletChamferCone { .. } => {
-            return Err(Error::InvalidInput(format!(
-                "mesh output not yet available for {}",
-                shape.name()
-            )))
-        }
+        | Shape::FilletChamferCone { .. } => super::trimmed::mesh_trimmed(shape, &model, target)?,
     };
     finish(shape, model, raw, p)
 }
 
-fn steps(length: f64, target: f64) -> usize {
+/// Number of pieces of about `target` length on a curve of length `length` (at least 1).
+pub(super) fn steps(length: f64, target: f64) -> usize {
     ((length / target).round() as usize).max(1)
 }
 
 /// Vertices, normals, vertex surface ids, faces, face surface ids.
 #[derive(Default)]
-struct Raw {
-    positions: Vec<Point3>,
-    normals: Vec<Point3>,
-    vsurf: Vec<u32>,
-    faces: Vec<[u32; 3]>,
-    fsurf: Vec<u32>,
+pub(super) struct Raw {
+    pub positions: Vec<Point3>,
+    pub normals: Vec<Point3>,
+    pub vsurf: Vec<u32>,
+    pub faces: Vec<[u32; 3]>,
+    pub fsurf: Vec<u32>,
     /// Exact outward normal of the face's patch near the face (orients it).
-    fnormal: Vec<Point3>,
+    pub fnormal: Vec<Point3>,
 }
 
 impl Raw {

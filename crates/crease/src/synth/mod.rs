@@ -28,6 +28,7 @@ mod mesh;
 mod sample;
 mod shapes;
 mod surfaces;
+mod trimmed;
 mod truth;
 
 use serde::Serialize;
