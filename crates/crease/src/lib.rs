@@ -21,3 +21,8 @@ pub mod synth;
 pub use error::{Error, Result};
 pub use geometry::{Aabb, Attribute, PointCloud, TriMesh};
 pub use io::Geometry;
+
+/// The README's Rust examples, compiled as doc tests so they stay true.
+#[doc = include_str!("../../../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

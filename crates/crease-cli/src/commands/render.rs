@@ -73,36 +73,45 @@ pub fn run(g: &Global, a: &RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The polylines and edges of `geom` as drawable polylines. Curves tagged by a `curve_kind` edge
-/// attribute (0 sharp, 1 smooth, 2 boundary, as `crease synth` writes them) get their colours.
+/// The polylines and edges of `geom` as drawable polylines: edges are chained into polylines
+/// (split at junctions), separately per kind when a `curve_kind` edge attribute tags them
+/// (0 sharp, 1 smooth, 2 boundary, as `crease synth` writes them), each kind in its colour.
 pub fn polylines_of(geom: &crease::io::Geometry, file_index: usize) -> Vec<Polyline> {
     let pts = &geom.points.positions;
     let palette = [[220, 30, 30], [30, 90, 220], [40, 160, 60], [200, 120, 0]];
     let default = palette[file_index % palette.len()];
-    let mut out = Vec::new();
-    for l in &geom.polylines {
-        let closed = l.len() > 2 && l.first() == l.last();
-        out.push(Polyline {
-            points: l.iter().map(|&i| pts[i as usize]).collect(),
-            closed,
-            color: default,
-            label: None,
-        });
-    }
+    let to_polyline = |chain: &[u32], color: [u8; 3], label: Option<&str>| Polyline {
+        points: chain.iter().map(|&i| pts[i as usize]).collect(),
+        closed: chain.len() > 2 && chain.first() == chain.last(),
+        color,
+        label: label.map(String::from),
+    };
+    let mut out: Vec<Polyline> = geom
+        .polylines
+        .iter()
+        .map(|l| to_polyline(l, default, None))
+        .collect();
     let kind = geom.edge_attributes.get("curve_kind");
-    for (i, e) in geom.edges.iter().enumerate() {
-        let (color, label) = match kind.map(|k| k.values[i] as i64) {
-            Some(0) => ([220, 30, 30], Some("sharp")),
-            Some(1) => ([30, 90, 220], Some("smooth")),
-            Some(2) => ([110, 110, 110], Some("boundary")),
-            _ => (default, None),
-        };
-        out.push(Polyline {
-            points: vec![pts[e[0] as usize], pts[e[1] as usize]],
-            closed: false,
-            color,
-            label: label.map(String::from),
-        });
+    let kinds: [(i64, [u8; 3], Option<&str>); 4] = [
+        (0, [220, 30, 30], Some("sharp")),
+        (1, [30, 90, 220], Some("smooth")),
+        (2, [110, 110, 110], Some("boundary")),
+        (-1, default, None),
+    ];
+    for (code, color, label) in kinds {
+        let edges: Vec<[u32; 2]> = geom
+            .edges
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| {
+                let k = kind.map_or(-1, |k| k.values[*i] as i64);
+                k == code || (code == -1 && !(0..=2).contains(&k))
+            })
+            .map(|(_, e)| *e)
+            .collect();
+        for chain in crease::geometry::chain_segments(pts.len(), &edges) {
+            out.push(to_polyline(&chain, color, label));
+        }
     }
     out
 }

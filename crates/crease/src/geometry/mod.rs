@@ -6,6 +6,7 @@ pub mod cleanup;
 mod csr;
 mod mesh;
 mod point_cloud;
+pub mod polyline;
 pub(crate) use point_cloud::retain_by;
 pub mod spacing;
 pub mod topology;
@@ -17,6 +18,7 @@ pub use cleanup::{clean_mesh, CleanupParams, CleanupReport};
 pub use csr::Csr;
 pub use mesh::TriMesh;
 pub use point_cloud::{Point3, PointCloud};
+pub use polyline::chain_segments;
 pub use spacing::{average_spacing, average_spacing_with};
 pub use topology::{
     face_area, face_areas, face_normal, face_normals, MeshTopology, OneRing, VertexKind,

@@ -166,16 +166,19 @@ pub(crate) fn resolve<'a>(scene: &Scene<'a>, color_by: &ColorBy) -> Result<Style
         }
         ColorBy::Attribute(name) => {
             let pa = points.and_then(|p| p.attribute(name).filter(|a| a.values.len() == p.len()));
-            let va = mesh.and_then(|m| {
-                m.vertices
-                    .attribute(name)
-                    .filter(|a| a.values.len() == m.num_vertices())
+            // A mesh attribute present per face and per vertex is drawn per face: faces are
+            // the unit of mesh labels (segments, surface ids), and per-vertex copies of them
+            // blur the borders between regions.
+            let fa = mesh.and_then(|m| {
+                m.face_attributes
+                    .get(name)
+                    .filter(|a| a.values.len() == m.num_faces())
             });
-            let fa = if va.is_none() {
+            let va = if fa.is_none() {
                 mesh.and_then(|m| {
-                    m.face_attributes
-                        .get(name)
-                        .filter(|a| a.values.len() == m.num_faces())
+                    m.vertices
+                        .attribute(name)
+                        .filter(|a| a.values.len() == m.num_vertices())
                 })
             } else {
                 None
