@@ -35,7 +35,7 @@ pub fn chain_segments(num_points: usize, segments: &[[u32; 2]]) -> Vec<Vec<u32>>
     let incident = Csr { offsets, indices };
     let mut used = vec![false; segs.len()];
     let mut out = Vec::new();
-    let mut walk = |start: u32, first_seg: u32, used: &mut Vec<bool>| {
+    let walk = |start: u32, first_seg: u32, used: &mut [bool]| {
         let mut chain = vec![start];
         let (mut at, mut seg) = (start, first_seg);
         loop {
@@ -59,8 +59,8 @@ pub fn chain_segments(num_points: usize, segments: &[[u32; 2]]) -> Vec<Vec<u32>>
         chain
     };
     // Open chains and chains between junctions start at points of degree != 2.
-    for v in 0..num_points {
-        if counts[v] == 2 || counts[v] == 0 {
+    for (v, &c) in counts.iter().enumerate() {
+        if c == 2 || c == 0 {
             continue;
         }
         for k in 0..incident.row_len(v) {
@@ -72,8 +72,8 @@ pub fn chain_segments(num_points: usize, segments: &[[u32; 2]]) -> Vec<Vec<u32>>
         }
     }
     // What is left are closed loops through degree-2 points only.
-    for v in 0..num_points {
-        if counts[v] != 2 {
+    for (v, &c) in counts.iter().enumerate() {
+        if c != 2 {
             continue;
         }
         if let Some(&e) = incident.row(v).iter().find(|&&e| !used[e as usize]) {
