@@ -12,6 +12,7 @@
 //! Each stage is a plain function: inputs and a `Params` struct in, a result struct out.
 
 pub mod error;
+pub mod estimate;
 pub mod geometry;
 pub mod io;
 pub mod render;

@@ -1,5 +1,7 @@
-//! Spatial queries: nearest neighbours over point sets.
+//! Spatial queries: nearest neighbours over point sets, local Delaunay 1-rings, mesh k-rings.
 
 mod kdtree;
+pub mod knn;
 
 pub use kdtree::KdIndex;
+pub use knn::{knn, Neighborhoods};

@@ -1,0 +1,5 @@
+//! Estimators every detector stands on: local planes, normals and curvature.
+
+pub mod plane;
+
+pub use plane::{fit_plane, Plane};
