@@ -1,5 +1,7 @@
 //! Estimators every detector stands on: local planes, normals and curvature.
 
 pub mod plane;
+pub mod ring_normal;
 
 pub use plane::{fit_plane, Plane};
+pub use ring_normal::ring_normals;

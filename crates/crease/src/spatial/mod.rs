@@ -2,6 +2,8 @@
 
 mod kdtree;
 pub mod knn;
+pub mod ring;
 
 pub use kdtree::KdIndex;
 pub use knn::{knn, Neighborhoods};
+pub use ring::{delaunay_rings, RingParams, Rings};
