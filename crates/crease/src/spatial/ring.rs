@@ -65,7 +65,9 @@ pub struct Rings {
     /// True where the point lies on the convex hull of its projected neighbourhood (up to
     /// [`HULL_ANGLE_TOLERANCE`]), and for
     /// points whose ring is empty (no plane could be fitted, or all neighbours coincide with
-    /// p) or collinear.
+    /// p) or collinear. On a random sample of a closed surface an interior point is flagged
+    /// when all its k neighbours happen to lie in a half-plane around it (probability about
+    /// k·2^(1−k), 4e-5 at k = 20, for a Poisson sample).
     pub boundary: Vec<bool>,
     /// Unit normal of the least-squares plane through the point and its k nearest neighbours
     /// (the projection plane), with the sign rule of [`canonical_sign`];
