@@ -28,7 +28,10 @@ fn bench(c: &mut Criterion) {
         let pts = part.cloud.positions;
         let t = Instant::now();
         let nbrs = knn(&pts, 20).expect("kNN");
-        eprintln!("{n} points: kNN k = 20 in {:.3} s", t.elapsed().as_secs_f64());
+        eprintln!(
+            "{n} points: kNN k = 20 in {:.3} s",
+            t.elapsed().as_secs_f64()
+        );
         let params = RingParams::default();
         group.bench_function(format!("delaunay_rings_k20_{n}"), |b| {
             b.iter(|| black_box(delaunay_rings(&pts, &nbrs, &params).expect("rings")))
