@@ -39,7 +39,7 @@
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
-use super::curvature::{monge_curvature, Curvature, Derivatives, PointCurvature};
+use super::curvature::{least_axis, monge_curvature, Curvature, Derivatives, PointCurvature};
 use crate::geometry::vec3::{add, cross, dist, dist2, dot, normalize, scale, sub};
 use crate::geometry::{MeshTopology, Point3, TriMesh};
 use crate::spatial::mesh_rings::VertexSet;
@@ -327,18 +327,6 @@ fn fit_vertex(
     match fit_quadric(&s.local, width * l_avg) {
         Some(d) => monge_curvature(&d, [e1, e2, n]),
         None => PointCurvature::FAILED,
-    }
-}
-
-/// The coordinate axis least aligned with `n`.
-fn least_axis(n: Point3) -> Point3 {
-    let a = [n[0].abs(), n[1].abs(), n[2].abs()];
-    if a[0] <= a[1] && a[0] <= a[2] {
-        [1.0, 0.0, 0.0]
-    } else if a[1] <= a[2] {
-        [0.0, 1.0, 0.0]
-    } else {
-        [0.0, 0.0, 1.0]
     }
 }
 

@@ -5,8 +5,9 @@
 //! [`super::bezier`].
 //!
 //! Per point `p` with neighbours `N(p)` (the first `k` of its kNN row):
-//! 1. The least-squares plane of `{p} ∪ N(p)` ([`super::fit_plane`]) gives an orthonormal frame
-//!    `(e1, e2, n)`; the frame's origin is `p` itself.
+//! 1. The least-squares plane of `{p} ∪ N(p)` (its normal is the eigenvector of the smallest
+//!    eigenvalue of the covariance, as in [`super::fit_plane`], computed here in closed form) gives
+//!    an orthonormal frame `(e1, e2, n)`; the frame's origin is `p` itself.
 //! 2. In that frame (coordinates scaled by the neighbourhood radius for conditioning) the height
 //!    function `z = a x² + b xy + c y² + d x + e y + f` is fitted by linear least squares
 //!    (6 × 6 normal equations, Cholesky on a fixed-size nalgebra matrix). The full form with the
@@ -30,7 +31,6 @@
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
-use super::fit_plane;
 use crate::geometry::vec3::{add, cross, dot, normalize, scale, sub};
 use crate::geometry::Point3;
 use crate::spatial::Neighborhoods;
@@ -263,20 +263,40 @@ fn fit_point(points: &[Point3], i: usize, row: &[u32]) -> PointCurvature {
         return PointCurvature::FAILED;
     }
     let p = points[i];
-    let items = std::iter::once(p)
-        .chain(row.iter().map(|&j| points[j as usize]))
-        .map(|q| (q, 1.0));
-    let Some(plane) = fit_plane(items) else {
+    // Covariance of {p} ∪ N(p), accumulated about p for precision, and the radius h.
+    let (mut m1, mut m2, mut h2) = ([0.0; 3], [0.0; 6], 0.0f64);
+    for &j in row {
+        let d = sub(points[j as usize], p);
+        h2 = h2.max(dot(d, d));
+        for a in 0..3 {
+            m1[a] += d[a];
+        }
+        m2[0] += d[0] * d[0];
+        m2[1] += d[0] * d[1];
+        m2[2] += d[0] * d[2];
+        m2[3] += d[1] * d[1];
+        m2[4] += d[1] * d[2];
+        m2[5] += d[2] * d[2];
+    }
+    let cnt = (row.len() + 1) as f64;
+    let c = m1.map(|v| v / cnt);
+    let cov = [
+        m2[0] / cnt - c[0] * c[0],
+        m2[1] / cnt - c[0] * c[1],
+        m2[2] / cnt - c[0] * c[2],
+        m2[3] / cnt - c[1] * c[1],
+        m2[4] / cnt - c[1] * c[2],
+        m2[5] / cnt - c[2] * c[2],
+    ];
+    let Some(n) = smallest_eigenvector(cov) else {
         return PointCurvature::FAILED;
     };
-    let n = plane.normal;
-    let e1 = plane.axes[2];
+    // The 6-term quadric is invariant under in-plane rotations: any tangent basis will do.
+    let Some(e1) = normalize(cross(n, least_axis(n))) else {
+        return PointCurvature::FAILED;
+    };
     let e2 = cross(n, e1);
-    let h = row
-        .iter()
-        .map(|&j| crate::geometry::vec3::dist2(points[j as usize], p))
-        .fold(0.0, f64::max)
-        .sqrt();
+    let h = h2.sqrt();
     if h <= 0.0 || !h.is_finite() {
         return PointCurvature::FAILED;
     }
@@ -309,6 +329,63 @@ fn fit_point(points: &[Point3], i: usize, row: &[u32]) -> PointCurvature {
         fyy: 2.0 * c[2] * inv,
     };
     monge_curvature(&d, [e1, e2, n])
+}
+
+/// The coordinate axis least aligned with `n`.
+pub(crate) fn least_axis(n: Point3) -> Point3 {
+    let a = [n[0].abs(), n[1].abs(), n[2].abs()];
+    if a[0] <= a[1] && a[0] <= a[2] {
+        [1.0, 0.0, 0.0]
+    } else if a[1] <= a[2] {
+        [0.0, 1.0, 0.0]
+    } else {
+        [0.0, 0.0, 1.0]
+    }
+}
+
+/// Unit eigenvector of the smallest eigenvalue of the symmetric matrix
+/// `[[a0, a1, a2], [a1, a3, a4], [a2, a4, a5]]`, in closed form: the eigenvalue from the
+/// trigonometric solution of the characteristic cubic (on the matrix scaled by its largest entry),
+/// the vector as the largest cross product of two rows of `A − λ I`. Accurate when the smallest
+/// eigenvalue is well separated from the others (a surface neighbourhood); `None` for a zero or
+/// non-finite matrix or a degenerate (line- or point-like) neighbourhood.
+pub(crate) fn smallest_eigenvector(a: [f64; 6]) -> Option<Point3> {
+    let s = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !(s > 0.0 && s.is_finite()) {
+        return None;
+    }
+    let a = a.map(|v| v / s);
+    let q = (a[0] + a[3] + a[5]) / 3.0;
+    let p1 = a[1] * a[1] + a[2] * a[2] + a[4] * a[4];
+    let (b0, b3, b5) = (a[0] - q, a[3] - q, a[5] - q);
+    let p2 = b0 * b0 + b3 * b3 + b5 * b5 + 2.0 * p1;
+    let p = (p2 / 6.0).sqrt();
+    if p < 1e-12 {
+        return None; // isotropic: no preferred normal
+    }
+    // det(B) / 2 with B = (A − q I) / p.
+    let det = b0 * (b3 * b5 - a[4] * a[4]) - a[1] * (a[1] * b5 - a[4] * a[2])
+        + a[2] * (a[1] * a[4] - b3 * a[2]);
+    let r = (det / (2.0 * p * p * p)).clamp(-1.0, 1.0);
+    let phi = r.acos() / 3.0;
+    // Smallest root: q + 2p cos(φ + 2π/3).
+    let lambda = q + 2.0 * p * (phi + 2.0 * std::f64::consts::FRAC_PI_3).cos();
+    let r0 = [a[0] - lambda, a[1], a[2]];
+    let r1 = [a[1], a[3] - lambda, a[4]];
+    let r2 = [a[2], a[4], a[5] - lambda];
+    let (c01, c02, c12) = (cross(r0, r1), cross(r0, r2), cross(r1, r2));
+    let (d01, d02, d12) = (dot(c01, c01), dot(c02, c02), dot(c12, c12));
+    let best = if d01 >= d02 && d01 >= d12 {
+        c01
+    } else if d02 >= d12 {
+        c02
+    } else {
+        c12
+    };
+    if dot(best, best) < 1e-24 {
+        return None;
+    }
+    normalize(best)
 }
 
 /// First and second derivatives of a height function `z = f(x, y)` at the evaluation point.
@@ -372,6 +449,35 @@ pub(crate) fn monge_curvature(d: &Derivatives, frame: [Point3; 3]) -> PointCurva
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn closed_form_normal_matches_fit_plane() {
+        let pts: Vec<Point3> = (0..30)
+            .map(|i| {
+                let (x, y) = ((i % 6) as f64 * 0.3, (i / 6) as f64 * 0.2 + 0.01 * i as f64);
+                [x, y, 0.2 * x - 0.1 * y + 0.01 * x * y]
+            })
+            .collect();
+        let plane = super::super::fit_plane(pts.iter().map(|&p| (p, 1.0))).unwrap();
+        let c = pts.iter().fold([0.0; 3], |s, p| add(s, *p));
+        let c = scale(c, 1.0 / 30.0);
+        let mut m = [0.0; 6];
+        for p in &pts {
+            let d = sub(*p, c);
+            m = [
+                m[0] + d[0] * d[0],
+                m[1] + d[0] * d[1],
+                m[2] + d[0] * d[2],
+                m[3] + d[1] * d[1],
+                m[4] + d[1] * d[2],
+                m[5] + d[2] * d[2],
+            ];
+        }
+        let n = smallest_eigenvector(m).unwrap();
+        assert!(dot(n, plane.normal).abs() > 1.0 - 1e-12);
+        assert!(smallest_eigenvector([0.0; 6]).is_none());
+        assert!(smallest_eigenvector([1.0, 0.0, 0.0, 1.0, 0.0, 1.0]).is_none());
+    }
 
     #[test]
     fn monge_paraboloid() {
