@@ -413,3 +413,46 @@ fn bezier_is_deterministic_across_thread_counts() {
     };
     assert_eq!(rings(1), rings(2));
 }
+
+#[test]
+fn degenerate_meshes_give_nan_not_panics() {
+    // A fan of 4 triangles, an isolated vertex (5), a face with a repeated vertex and a
+    // dangling non-manifold fin on edge 0-1.
+    let pos = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [5.0, 5.0, 5.0],
+        [0.5, 0.0, 1.0],
+    ];
+    let faces = vec![
+        [0, 1, 2],
+        [0, 2, 3],
+        [0, 3, 4],
+        [0, 4, 1],
+        [2, 2, 3],
+        [0, 1, 6],
+    ];
+    let mesh = TriMesh::new(pos, faces).unwrap();
+    let topo = MeshTopology::new(&mesh).unwrap();
+    let b = bezier_curvature(&mesh, &topo, &BezierParams::default()).unwrap();
+    assert_eq!(b.curvature.len(), 7);
+    assert!(b.curvature.k1[5].is_nan() && !b.sharp[5]);
+    let rings = vertex_k_rings(&topo, 2).unwrap();
+    assert_eq!(rings.row(5), &[] as &[u32]);
+    assert_eq!(rings.row(0), &[1, 2, 3, 4, 6]);
+    // Invalid parameters are refused.
+    let bad = BezierParams {
+        first_width: 0.0,
+        ..Default::default()
+    };
+    assert!(bezier_curvature(&mesh, &topo, &bad).is_err());
+    let other = TriMesh::new(vec![[0.0; 3]; 3], vec![[0, 1, 2]]).unwrap();
+    assert!(bezier_curvature(&other, &topo, &BezierParams::default()).is_err());
+    // A mesh whose edges all have zero length.
+    let flat = TriMesh::new(vec![[1.0; 3]; 3], vec![[0, 1, 2]]).unwrap();
+    let ft = MeshTopology::new(&flat).unwrap();
+    assert!(bezier_curvature(&flat, &ft, &BezierParams::default()).is_err());
+}
