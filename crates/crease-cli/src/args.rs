@@ -53,6 +53,8 @@ pub enum Command {
     },
     /// Generate a synthetic part with exact ground truth.
     Synth(SynthArgs),
+    /// Principal curvatures (k1 k2 mean_curvature) of every point or mesh vertex.
+    Curvature(crate::commands::curvature::CurvatureArgs),
     /// Draw points, meshes and polylines into a PNG (four views by default).
     Render(RenderArgs),
     /// Run every capability on a built-in synthetic part; no input files needed.

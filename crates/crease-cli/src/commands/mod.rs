@@ -1,6 +1,7 @@
 //! One module per subcommand; each reads its inputs, calls the library, writes its outputs.
 
 mod convert;
+pub mod curvature;
 mod demo;
 mod info;
 mod render;
@@ -25,6 +26,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         } => convert::run(g, &input, &output, ascii),
         Command::Synth(a) => synth::run(g, &a),
         Command::Render(a) => render::run(g, &a),
+        Command::Curvature(a) => curvature::run(g, &a),
         Command::Demo { output, n } => demo::run(g, &output, n),
     }
 }

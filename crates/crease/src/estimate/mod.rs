@@ -1,5 +1,7 @@
 //! Estimators every detector stands on: local planes, normals and curvature.
 
+pub mod bezier;
+pub mod curvature;
 pub mod plane;
 pub mod ring_normal;
 

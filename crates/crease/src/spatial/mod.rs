@@ -2,6 +2,7 @@
 
 mod kdtree;
 pub mod knn;
+pub mod mesh_rings;
 pub mod ring;
 
 pub use kdtree::KdIndex;
