@@ -1,5 +1,11 @@
 //! Estimators every detector stands on: local planes, normals and curvature.
 
+pub mod normals;
+pub mod orient;
 pub mod plane;
 
+pub use normals::{
+    estimate_normals, mesh_vertex_normals, pca_normals, PcaParams, PcaResult, PcaWeight, Weighting,
+};
+pub use orient::orient_normals;
 pub use plane::{fit_plane, Plane};
