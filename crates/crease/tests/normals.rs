@@ -85,9 +85,9 @@ fn pca_accuracy_plane_sphere_cylinder() {
     assert!((4.0..6.5).contains(&ratio), "{ratio}");
 }
 
-/// The weights of equation 1: σ = 2 × the mean distance (default) costs under 3 % of median
-/// error against plain PCA under noise; σ = 1 × the mean distance narrows the neighbourhood and
-/// costs over 10 % (measured 8.02° vs 6.79°); the paper's literal σ = k on a unit-sized part
+/// The weights of equation 1: σ = 2 × the RMS distance to the centroid (default) costs under
+/// 3 % of median error against plain PCA under noise (measured 6.86° vs 6.79°); σ = 1 × narrows
+/// the neighbourhood and costs over 10 % (measured 7.74°); the paper's literal σ = k on a unit-sized part
 /// makes every weight ≈ 1, i.e. plain PCA.
 #[test]
 fn pca_weight_variants() {
@@ -389,5 +389,72 @@ fn measure_all() {
         let n = mesh_vertex_normals(&m.mesh, w).unwrap();
         let s = angle_stats(&n, &truth);
         eprintln!("mesh {w:?}: median {:.4}° p95 {:.4}°", s.0, s.1);
+    }
+}
+
+/// Timing at 1M points (cube faces, k = 20) in random and Morton-sorted order; run with
+/// `cargo test --release -p crease --test normals timing_1m -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn timing_1m() {
+    use std::time::Instant;
+    // Process CPU time (user + system) in seconds, from /proc (load-independent-ish).
+    fn cpu() -> f64 {
+        let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+        let f: Vec<&str> = s
+            .rsplit(')')
+            .next()
+            .unwrap_or("")
+            .split_whitespace()
+            .collect();
+        let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+        (t(11) + t(12)) / 100.0
+    }
+    let n: usize = std::env::var("CREASE_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1_000_000);
+    let part = sample("cube", n, 0.0);
+    let random = part.cloud.positions.clone();
+    // Sorted: along a Morton curve of the positions.
+    let mut keyed: Vec<(u64, usize)> = random
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let q = |v: f64| (((v + 0.5) * 1023.0) as u64).min(1023);
+            let mut code = 0u64;
+            for b in 0..10 {
+                code |= ((q(p[0]) >> b) & 1) << (3 * b)
+                    | ((q(p[1]) >> b) & 1) << (3 * b + 1)
+                    | ((q(p[2]) >> b) & 1) << (3 * b + 2);
+            }
+            (code, i)
+        })
+        .collect();
+    keyed.sort_unstable();
+    let sorted: Vec<Point3> = keyed.iter().map(|&(_, i)| random[i]).collect();
+    for (name, pts) in [("random", &random), ("sorted", &sorted)] {
+        let t = Instant::now();
+        let nbrs = knn(pts, 20).unwrap();
+        let t_knn = t.elapsed().as_secs_f64();
+        for w in [PcaParams::default().weight, PcaWeight::Uniform] {
+            let (t, c) = (Instant::now(), cpu());
+            let r = pca_normals(pts, &nbrs, &PcaParams { k: 20, weight: w }).unwrap();
+            let t_pca = t.elapsed().as_secs_f64();
+            std::hint::black_box(&r);
+            eprintln!(
+                "{name} n={n}: knn {t_knn:.3} s, pca {w:?} {t_pca:.3} s wall, {:.2} s cpu",
+                cpu() - c
+            );
+        }
+        let r = pca_normals(pts, &nbrs, &PcaParams::default()).unwrap();
+        let (t, c) = (Instant::now(), cpu());
+        let o = orient_normals(pts, &r.normals, &nbrs).unwrap();
+        eprintln!(
+            "{name}: orient {:.3} s wall, {:.2} s cpu",
+            t.elapsed().as_secs_f64(),
+            cpu() - c
+        );
+        std::hint::black_box(o);
     }
 }
