@@ -3,6 +3,7 @@
 mod convert;
 mod demo;
 mod info;
+pub(crate) mod normals;
 mod render;
 mod synth;
 
@@ -26,6 +27,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Synth(a) => synth::run(g, &a),
         Command::Render(a) => render::run(g, &a),
         Command::Demo { output, n } => demo::run(g, &output, n),
+        Command::Normals(a) => normals::run(g, &a),
     }
 }
 
