@@ -333,6 +333,18 @@ fn errors() {
     )
     .is_err());
     assert!(pca_normals(&pts[..50], &nbrs, &PcaParams::default()).is_err());
+    let nbrs10 = knn(pts, 10).unwrap();
+    assert!(pca_normals(pts, &nbrs10, &PcaParams::default()).is_err());
+    // A prefix of larger lists is fine.
+    assert!(pca_normals(
+        pts,
+        &nbrs,
+        &PcaParams {
+            k: 8,
+            ..Default::default()
+        }
+    )
+    .is_ok());
     assert!(pca_normals(
         pts,
         &nbrs,

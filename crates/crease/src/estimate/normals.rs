@@ -95,7 +95,7 @@ impl PcaResult {
 
 /// Weighted-PCA normals (tran equation 1) of every point from precomputed neighbourhoods.
 ///
-/// Errors if `params.k` is 0, if `nbrs` was built for another number of points, or if a
+/// Errors if `params.k` is 0 or larger than `nbrs.k()`, if `nbrs` was built for another number of points, or if a
 /// neighbour index is out of range.
 pub fn pca_normals(
     points: &[Point3],
@@ -111,6 +111,13 @@ pub fn pca_normals(
                 "PCA normals: Gaussian sigma must be positive and finite, got {s}"
             )));
         }
+    }
+    if params.k > nbrs.k() {
+        return Err(Error::InvalidArgument(format!(
+            "PCA normals with k = {} from neighbourhoods of only {} neighbours",
+            params.k,
+            nbrs.k()
+        )));
     }
     if nbrs.len() != points.len() {
         return Err(Error::InvalidArgument(format!(
