@@ -57,6 +57,8 @@ pub enum Command {
     Curvature(crate::commands::curvature::CurvatureArgs),
     /// Draw points, meshes and polylines into a PNG (four views by default).
     Render(RenderArgs),
+    /// Estimate a normal per point (PCA, Delaunay 1-ring or mesh faces), optionally oriented.
+    Normals(crate::commands::normals::NormalsArgs),
     /// Run every capability on a built-in synthetic part; no input files needed.
     Demo {
         /// Folder to write the results into.

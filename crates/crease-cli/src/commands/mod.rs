@@ -4,6 +4,7 @@ mod convert;
 pub mod curvature;
 mod demo;
 mod info;
+pub(crate) mod normals;
 mod render;
 mod synth;
 
@@ -28,6 +29,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(a) => render::run(g, &a),
         Command::Curvature(a) => curvature::run(g, &a),
         Command::Demo { output, n } => demo::run(g, &output, n),
+        Command::Normals(a) => normals::run(g, &a),
     }
 }
 

@@ -2,8 +2,14 @@
 
 pub mod bezier;
 pub mod curvature;
+pub mod normals;
+pub mod orient;
 pub mod plane;
 pub mod ring_normal;
 
+pub use normals::{
+    estimate_normals, mesh_vertex_normals, pca_normals, PcaParams, PcaResult, PcaWeight, Weighting,
+};
+pub use orient::orient_normals;
 pub use plane::{fit_plane, Plane};
 pub use ring_normal::ring_normals;
