@@ -1,7 +1,10 @@
 //! Spatial queries: nearest neighbours over point sets, local Delaunay 1-rings, mesh k-rings.
 
+mod grid;
 mod kdtree;
 pub mod knn;
+pub mod morton;
 
 pub use kdtree::KdIndex;
-pub use knn::{knn, Neighborhoods};
+pub use knn::{knn, knn_with, KnnMethod, Neighborhoods};
+pub use morton::morton_order;
