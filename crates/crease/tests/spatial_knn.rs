@@ -248,10 +248,24 @@ fn timing_1m_cube_faces() {
         for (label, cloud) in [("random", &p), ("sorted", &sorted)] {
             for &m in &methods {
                 let t = std::time::Instant::now();
+                let c = cpu_seconds();
                 let nb = pool.install(|| knn_with(cloud, 20, m).unwrap());
-                eprintln!("{threads} thr {label:6} {m:?}: {:.3} s", t.elapsed().as_secs_f64());
+                eprintln!(
+                    "{threads} thr {label:6} {m:?}: {:.3} s wall, {:.2} s cpu",
+                    t.elapsed().as_secs_f64(),
+                    cpu_seconds() - c
+                );
                 std::hint::black_box(nb);
             }
         }
     }
+}
+
+/// User + system CPU time of this process (Linux), for timings on a loaded machine.
+fn cpu_seconds() -> f64 {
+    let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let after = s.rsplit(')').next().unwrap_or("");
+    let f: Vec<&str> = after.split_whitespace().collect();
+    let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (t(11) + t(12)) / 100.0
 }

@@ -191,22 +191,23 @@ pub fn knn_with(points: &[Point3], k: usize, method: KnnMethod) -> Result<Neighb
         }
         KnnMethod::Grid => {
             let quant = Quantizer::new(points).ok_or_else(|| Error::InvalidInput("empty".into()))?;
+            let t0 = std::time::Instant::now();
             let sorted = morton_sorted(points, &quant);
+            let t1 = t0.elapsed().as_secs_f64();
             let r = estimate_kth_distance(points, &sorted, k);
-            let level = level_for(&quant, r * CELL_RATIO);
+            let ratio: f64 = std::env::var("KNN_RATIO").ok().and_then(|v| v.parse().ok()).unwrap_or(CELL_RATIO);
+            let level = level_for(&quant, r * ratio);
+            let t2 = t0.elapsed().as_secs_f64();
             let grid = CellGrid::new(points, quant, &sorted, level);
             drop(sorted);
+            let t3 = t0.elapsed().as_secs_f64();
+            eprintln!("PROF sort {t1:.3} est {:.3} grid {:.3} r {r} cell {}", t2-t1, t3-t2, grid.cell_size);
             let mut buf = vec![0u32; n * k];
             let done: Vec<bool> = buf
                 .par_chunks_mut(k)
                 .enumerate()
-                .map_init(Best::default, |best, (r, row)| {
-                    best.reset(k);
-                    let ok = grid_query(&grid, r, MAX_SHELLS, best);
-                    if ok {
-                        row.copy_from_slice(&best.id);
-                    }
-                    ok
+                .map_init(Scratch::default, |scratch, (r, row)| {
+                    grid_query(&grid, r, k, MAX_SHELLS, scratch, row)
                 })
                 .collect();
             let failed: Vec<usize> = done
@@ -218,22 +219,32 @@ pub fn knn_with(points: &[Point3], k: usize, method: KnnMethod) -> Result<Neighb
                 let index = KdIndex::new(&grid.points);
                 let rows: Vec<Vec<u32>> = failed
                     .par_iter()
-                    .map_init(Best::default, |best, &r| {
-                        best.reset(k);
-                        match &index {
-                            Some(index) => kd_query(index, &grid.points, &grid.ids, r, best),
-                            None => {
-                                grid_query(&grid, r, i64::MAX, best);
+                    .map_init(
+                        || (Best::default(), Scratch::default()),
+                        |(best, scratch), &r| {
+                            let mut row = vec![0u32; k];
+                            match &index {
+                                Some(index) => {
+                                    best.reset(k);
+                                    kd_query(index, &grid.points, &grid.ids, r, best);
+                                    row.copy_from_slice(&best.id);
+                                }
+                                None => {
+                                    grid_query(&grid, r, k, i64::MAX, scratch, &mut row);
+                                }
                             }
-                        }
-                        best.id.clone()
-                    })
+                            row
+                        },
+                    )
                     .collect();
                 for (&r, row) in failed.iter().zip(rows) {
                     buf[r * k..(r + 1) * k].copy_from_slice(&row);
                 }
             }
-            gather_fixed(&buf, &grid.ids, k)
+            let t4 = t0.elapsed().as_secs_f64();
+            let o = gather_fixed(&buf, &grid.ids, k);
+            eprintln!("PROF query {:.3} gather {:.3} failed {}", t4-t3, t0.elapsed().as_secs_f64()-t4, failed.len());
+            o
         }
     };
     Ok(Neighborhoods::from_csr(
@@ -353,34 +364,78 @@ impl Best {
     }
 }
 
-/// Grid search for sorted point `r`, at most `max_shells` shells; false when unfinished.
-fn grid_query(grid: &CellGrid, r: usize, max_shells: i64, best: &mut Best) -> bool {
+/// Per-thread state of the grid search.
+#[derive(Default)]
+struct Scratch {
+    /// Candidates as (squared distance bits, input index): for non-negative floats the bit
+    /// patterns order like the values, so tuples sort by distance then index.
+    cands: Vec<(u64, u32)>,
+    /// The previous query of this thread and the distance to its k-th neighbour.
+    prev: Option<(Point3, f64)>,
+}
+
+/// Grid search for sorted point `r`, at most `max_shells` shells; writes the k nearest input
+/// indices to `row` and returns true, or false when unfinished.
+///
+/// The previous query p of the same thread bounds the search: p and its k neighbours are k + 1
+/// points within `d_k(p) + |q - p|` of q, so at least k points other than q lie that close, and
+/// farther candidates and cells are skipped from the start.
+fn grid_query(
+    grid: &CellGrid,
+    r: usize,
+    k: usize,
+    max_shells: i64,
+    scratch: &mut Scratch,
+    row: &mut [u32],
+) -> bool {
     let q = grid.points[r];
     let c = grid.cell_of(&q);
+    let cands = &mut scratch.cands;
+    cands.clear();
+    let mut t2 = match scratch.prev {
+        Some((p, dk)) => {
+            let b = (dk + dist2(&p, &q).sqrt()) * (1.0 + 1e-9);
+            b * b
+        }
+        None => f64::INFINITY,
+    };
+    let mut t2_bits = t2.to_bits();
     let mut s = 0i64;
     loop {
         grid.for_each_shell_cell(c, s, |cell| {
-            let worst = best.worst();
-            if worst.is_finite() && grid.cell_min_dist2(&q, cell) > worst {
+            if grid.cell_min_dist2(&q, cell) > t2 {
                 return;
             }
             let range = grid.cell_range(cell);
-            for j in range {
-                if j == r {
-                    continue;
+            let (lo, hi) = (range.start, range.end);
+            for (j, p) in grid.points[lo..hi].iter().enumerate() {
+                let d = dist2(&q, p).to_bits();
+                if d <= t2_bits && lo + j != r {
+                    cands.push((d, grid.ids[lo + j]));
                 }
-                let d = dist2(&q, &grid.points[j]);
-                best.offer(d, grid.ids[j]);
             }
         });
-        if grid.covers_all(c, s) {
-            return true;
-        }
-        if best.full() {
+        if cands.len() >= k {
+            if cands.len() > k {
+                cands.select_nth_unstable(k - 1);
+                cands.truncate(k);
+            }
+            let kth = cands.iter().map(|c| c.0).max().unwrap_or(0);
+            t2_bits = kth;
+            t2 = f64::from_bits(kth);
             let b = grid.shell_bound(&q, c, s);
-            if b > 0.0 && best.worst() < b * b {
+            if grid.covers_all(c, s) || (b > 0.0 && t2 < b * b) {
+                cands.sort_unstable();
+                for (o, c) in row.iter_mut().zip(cands.iter()) {
+                    *o = c.1;
+                }
+                scratch.prev = Some((q, t2.sqrt()));
                 return true;
             }
+        } else if grid.covers_all(c, s) {
+            // Unreachable for n > k (every point was a candidate); keep the search sound anyway.
+            scratch.prev = None;
+            return false;
         }
         if s >= max_shells {
             return false;
