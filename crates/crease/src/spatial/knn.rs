@@ -372,6 +372,29 @@ struct Scratch {
     cands: Vec<(u64, u32)>,
     /// The previous query of this thread and the distance to its k-th neighbour.
     prev: Option<(Point3, f64)>,
+    /// The cell whose 3 x 3 x 3 block is in `near`.
+    cell: Option<[i64; 3]>,
+    /// Non-empty cells of that block: (cell, first, end) sorted positions.
+    near: Vec<([i64; 3], usize, usize)>,
+}
+
+/// Appends the points of sorted range `lo..hi` within squared distance `t2_bits` of `q`
+/// (except sorted point `r`) to `cands`, without data-dependent branches.
+#[inline]
+fn scan(grid: &CellGrid, q: &Point3, r: usize, lo: usize, hi: usize, t2_bits: u64, cands: &mut Vec<(u64, u32)>) {
+    let base = cands.len();
+    cands.resize(base + (hi - lo), (0, 0));
+    let mut w = base;
+    let pts = &grid.points[lo..hi];
+    let ids = &grid.ids[lo..hi];
+    for (j, (p, &id)) in pts.iter().zip(ids).enumerate() {
+        let d = dist2(q, p).to_bits();
+        if let Some(slot) = cands.get_mut(w) {
+            *slot = (d, id);
+        }
+        w += usize::from(d <= t2_bits && lo + j != r);
+    }
+    cands.truncate(w);
 }
 
 /// Grid search for sorted point `r`, at most `max_shells` shells; writes the k nearest input
@@ -379,7 +402,8 @@ struct Scratch {
 ///
 /// The previous query p of the same thread bounds the search: p and its k neighbours are k + 1
 /// points within `d_k(p) + |q - p|` of q, so at least k points other than q lie that close, and
-/// farther candidates and cells are skipped from the start.
+/// farther candidates and cells are skipped from the start. Consecutive queries (Morton order)
+/// mostly share a cell, so the cell's 3 x 3 x 3 block is looked up once for all of them.
 fn grid_query(
     grid: &CellGrid,
     r: usize,
@@ -390,8 +414,6 @@ fn grid_query(
 ) -> bool {
     let q = grid.points[r];
     let c = grid.cell_of(&q);
-    let cands = &mut scratch.cands;
-    cands.clear();
     let mut t2 = match scratch.prev {
         Some((p, dk)) => {
             let b = (dk + dist2(&p, &q).sqrt()) * (1.0 + 1e-9);
@@ -400,21 +422,27 @@ fn grid_query(
         None => f64::INFINITY,
     };
     let mut t2_bits = t2.to_bits();
-    let mut s = 0i64;
-    loop {
-        grid.for_each_shell_cell(c, s, |cell| {
-            if grid.cell_min_dist2(&q, cell) > t2 {
-                return;
-            }
-            let range = grid.cell_range(cell);
-            let (lo, hi) = (range.start, range.end);
-            for (j, p) in grid.points[lo..hi].iter().enumerate() {
-                let d = dist2(&q, p).to_bits();
-                if d <= t2_bits && lo + j != r {
-                    cands.push((d, grid.ids[lo + j]));
+    if scratch.cell != Some(c) {
+        scratch.near.clear();
+        for s in 0..=1 {
+            grid.for_each_shell_cell(c, s, |cell| {
+                let range = grid.cell_range(cell);
+                if !range.is_empty() {
+                    scratch.near.push((cell, range.start, range.end));
                 }
-            }
-        });
+            });
+        }
+        scratch.cell = Some(c);
+    }
+    let cands = &mut scratch.cands;
+    cands.clear();
+    for &(cell, lo, hi) in &scratch.near {
+        if grid.cell_min_dist2(&q, cell) <= t2 {
+            scan(grid, &q, r, lo, hi, t2_bits, cands);
+        }
+    }
+    let mut s = 1i64;
+    loop {
         if cands.len() >= k {
             if cands.len() > k {
                 cands.select_nth_unstable(k - 1);
@@ -434,13 +462,19 @@ fn grid_query(
             }
         } else if grid.covers_all(c, s) {
             // Unreachable for n > k (every point was a candidate); keep the search sound anyway.
-            scratch.prev = None;
             return false;
         }
         if s >= max_shells {
             return false;
         }
         s += 1;
+        grid.for_each_shell_cell(c, s, |cell| {
+            if grid.cell_min_dist2(&q, cell) > t2 {
+                return;
+            }
+            let range = grid.cell_range(cell);
+            scan(grid, &q, r, range.start, range.end, t2_bits, cands);
+        });
     }
 }
 
