@@ -2,7 +2,7 @@
 //! index), prefixes, input order, thread-count independence, argument errors.
 
 use crease::geometry::Point3;
-use crease::spatial::{knn, knn_with, KnnMethod};
+use crease::spatial::{knn, knn_with, knn_within, radius_neighbors, KnnMethod};
 use crease::synth::{sample_points, Noise, SampleParams, Shape};
 
 /// Deterministic pseudo-random numbers in [0, 1).
@@ -229,6 +229,66 @@ fn argument_errors() {
     assert!(knn(&bad, 3).is_err());
     bad[4][1] = f64::INFINITY;
     assert!(knn(&bad, 3).is_err());
+}
+
+/// Brute-force neighbours within r (d² ≤ r²), self excluded, sorted by distance then index.
+fn brute_radius(p: &[Point3], i: usize, r: f64) -> Vec<u32> {
+    let mut v: Vec<(f64, u32)> = (0..p.len())
+        .filter(|&j| j != i)
+        .map(|j| (d2(&p[i], &p[j]), j as u32))
+        .filter(|x| x.0 <= r * r)
+        .collect();
+    v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    v.into_iter().map(|x| x.1).collect()
+}
+
+#[test]
+fn radius_search_equals_brute_force() {
+    let clouds = [
+        ("cube surface", surface("cube", 3000, 12), vec![0.0, 0.01, 0.05, 0.2]),
+        ("random", random_cube(1500, 13), vec![0.03, 0.1, 2.0]),
+        // Radii equal to grid distances: points exactly on the sphere are included.
+        ("tie grid", tie_grid(), vec![0.0, 1.0, 2.0, 2f64.sqrt(), 3.0]),
+    ];
+    for (what, p, radii) in clouds {
+        for r in radii {
+            let csr = radius_neighbors(&p, r).unwrap();
+            assert_eq!(csr.num_rows(), p.len());
+            let mut total = 0;
+            for i in 0..p.len() {
+                let expect = brute_radius(&p, i, r);
+                total += expect.len();
+                assert_eq!(csr.row(i), expect.as_slice(), "{what}: r = {r}, point {i}");
+            }
+            if r > 0.0 {
+                assert!(total > 0, "{what}: r = {r} finds nothing");
+            }
+        }
+    }
+    assert!(radius_neighbors(&tie_grid(), -1.0).is_err());
+    assert!(radius_neighbors(&tie_grid(), f64::NAN).is_err());
+    assert_eq!(radius_neighbors(&[], 1.0).unwrap().num_rows(), 0);
+}
+
+#[test]
+fn knn_within_equals_brute_force() {
+    let p = surface("cylinder", 3000, 14);
+    let t = tie_grid();
+    for (cloud, r) in [(&p, 0.005), (&p, 0.02), (&p, 1.0), (&t, 1.0), (&t, 2.5)] {
+        for k in [1, 8, 20] {
+            let nb = knn_within(cloud, k, r).unwrap();
+            for i in 0..cloud.len() {
+                let mut expect = brute_radius(cloud, i, r);
+                expect.truncate(k);
+                assert_eq!(nb.of(i), expect.as_slice(), "r = {r}, k = {k}, point {i}");
+            }
+        }
+    }
+    // Fewer points than k: shorter rows, no error.
+    let few = random_cube(5, 2);
+    let nb = knn_within(&few, 10, 10.0).unwrap();
+    assert_eq!(nb.of(0).len(), 4);
+    assert!(knn_within(&few, 0, 1.0).is_err());
 }
 
 /// Timing of the methods on 1M points of a cube's faces (run with `--release -- --ignored`).

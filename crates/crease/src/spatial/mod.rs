@@ -4,7 +4,9 @@ mod grid;
 mod kdtree;
 pub mod knn;
 pub mod morton;
+pub mod radius;
 
 pub use kdtree::KdIndex;
 pub use knn::{knn, knn_with, KnnMethod, Neighborhoods};
 pub use morton::morton_order;
+pub use radius::{knn_within, radius_neighbors};
