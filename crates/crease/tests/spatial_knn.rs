@@ -189,14 +189,18 @@ fn input_order_is_restored() {
         for i in 0..q.len() {
             let expect: Vec<u32> = brute_knn(&q, i, k);
             assert_eq!(b.of(i), expect.as_slice());
-            let mapped: Vec<f64> = a.of(perm[i]).iter().map(|&j| d2(&p[perm[i]], &p[j as usize])).collect();
+            let mapped: Vec<f64> = a
+                .of(perm[i])
+                .iter()
+                .map(|&j| d2(&p[perm[i]], &p[j as usize]))
+                .collect();
             let got: Vec<f64> = b.of(i).iter().map(|&j| d2(&q[i], &q[j as usize])).collect();
             assert_eq!(mapped, got);
         }
         // Without ties (a jittered surface) the rows map exactly.
         if p.len() == 5000 {
-            for i in 0..q.len() {
-                let mapped: Vec<u32> = a.of(perm[i]).iter().map(|&j| inv[j as usize]).collect();
+            for (i, &pi) in perm.iter().enumerate() {
+                let mapped: Vec<u32> = a.of(pi).iter().map(|&j| inv[j as usize]).collect();
                 assert_eq!(b.of(i), mapped.as_slice());
             }
         }
@@ -245,10 +249,18 @@ fn brute_radius(p: &[Point3], i: usize, r: f64) -> Vec<u32> {
 #[test]
 fn radius_search_equals_brute_force() {
     let clouds = [
-        ("cube surface", surface("cube", 3000, 12), vec![0.0, 0.01, 0.05, 0.2]),
+        (
+            "cube surface",
+            surface("cube", 3000, 12),
+            vec![0.0, 0.01, 0.05, 0.2],
+        ),
         ("random", random_cube(1500, 13), vec![0.03, 0.1, 2.0]),
         // Radii equal to grid distances: points exactly on the sphere are included.
-        ("tie grid", tie_grid(), vec![0.0, 1.0, 2.0, 2f64.sqrt(), 3.0]),
+        (
+            "tie grid",
+            tie_grid(),
+            vec![0.0, 1.0, 2.0, 2f64.sqrt(), 3.0],
+        ),
     ];
     for (what, p, radii) in clouds {
         for r in radii {
@@ -295,7 +307,10 @@ fn knn_within_equals_brute_force() {
 #[test]
 #[ignore]
 fn timing_1m_cube_faces() {
-    let n: usize = std::env::var("KNN_N").ok().and_then(|v| v.parse().ok()).unwrap_or(1_000_000);
+    let n: usize = std::env::var("KNN_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1_000_000);
     let p = surface("cube", n, 1);
     let order = crease::spatial::morton_order(&p);
     let sorted: Vec<Point3> = order.iter().map(|&i| p[i as usize]).collect();
@@ -304,7 +319,10 @@ fn timing_1m_cube_faces() {
         _ => vec![KnnMethod::Grid, KnnMethod::KdTreeMorton, KnnMethod::KdTree],
     };
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         for (label, cloud) in [("random", &p), ("sorted", &sorted)] {
             for &m in &methods {
                 let t = std::time::Instant::now();

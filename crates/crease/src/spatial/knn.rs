@@ -171,7 +171,8 @@ pub fn knn_with(points: &[Point3], k: usize, method: KnnMethod) -> Result<Neighb
             out
         }
         KnnMethod::KdTreeMorton => {
-            let quant = Quantizer::new(points).ok_or_else(|| Error::InvalidInput("empty".into()))?;
+            let quant =
+                Quantizer::new(points).ok_or_else(|| Error::InvalidInput("empty".into()))?;
             let sorted = morton_sorted(points, &quant);
             let sp: Vec<Point3> = sorted.iter().map(|&(_, i)| points[i as usize]).collect();
             let ids: Vec<u32> = sorted.iter().map(|&(_, i)| i).collect();
@@ -190,18 +191,13 @@ pub fn knn_with(points: &[Point3], k: usize, method: KnnMethod) -> Result<Neighb
             gather_fixed(&buf, &ids, k)
         }
         KnnMethod::Grid => {
-            let quant = Quantizer::new(points).ok_or_else(|| Error::InvalidInput("empty".into()))?;
-            let t0 = std::time::Instant::now();
+            let quant =
+                Quantizer::new(points).ok_or_else(|| Error::InvalidInput("empty".into()))?;
             let sorted = morton_sorted(points, &quant);
-            let t1 = t0.elapsed().as_secs_f64();
             let r = estimate_kth_distance(points, &sorted, k);
-            let ratio: f64 = std::env::var("KNN_RATIO").ok().and_then(|v| v.parse().ok()).unwrap_or(CELL_RATIO);
-            let level = level_for(&quant, r * ratio);
-            let t2 = t0.elapsed().as_secs_f64();
+            let level = level_for(&quant, r * CELL_RATIO);
             let grid = CellGrid::new(points, quant, &sorted, level);
             drop(sorted);
-            let t3 = t0.elapsed().as_secs_f64();
-            eprintln!("PROF sort {t1:.3} est {:.3} grid {:.3} r {r} cell {}", t2-t1, t3-t2, grid.cell_size);
             let mut buf = vec![0u32; n * k];
             let done: Vec<bool> = buf
                 .par_chunks_mut(k)
@@ -241,10 +237,7 @@ pub fn knn_with(points: &[Point3], k: usize, method: KnnMethod) -> Result<Neighb
                     buf[r * k..(r + 1) * k].copy_from_slice(&row);
                 }
             }
-            let t4 = t0.elapsed().as_secs_f64();
-            let o = gather_fixed(&buf, &grid.ids, k);
-            eprintln!("PROF query {:.3} gather {:.3} failed {}", t4-t3, t0.elapsed().as_secs_f64()-t4, failed.len());
-            o
+            gather_fixed(&buf, &grid.ids, k)
         }
     };
     Ok(Neighborhoods::from_csr(
@@ -302,7 +295,7 @@ pub(crate) fn estimate_kth_distance(points: &[Point3], sorted: &[(u64, u32)], k:
 
 /// The grid level (cell side 2^level units) closest to `cell` in log scale.
 pub(crate) fn level_for(quant: &Quantizer, cell: f64) -> u32 {
-    if !(cell > 0.0) || !cell.is_finite() {
+    if cell.is_nan() || cell <= 0.0 || cell.is_infinite() {
         return 0;
     }
     let l = (cell / quant.unit).log2().round();
@@ -381,7 +374,15 @@ struct Scratch {
 /// Appends the points of sorted range `lo..hi` within squared distance `t2_bits` of `q`
 /// (except sorted point `r`) to `cands`, without data-dependent branches.
 #[inline]
-fn scan(grid: &CellGrid, q: &Point3, r: usize, lo: usize, hi: usize, t2_bits: u64, cands: &mut Vec<(u64, u32)>) {
+fn scan(
+    grid: &CellGrid,
+    q: &Point3,
+    r: usize,
+    lo: usize,
+    hi: usize,
+    t2_bits: u64,
+    cands: &mut Vec<(u64, u32)>,
+) {
     let base = cands.len();
     cands.resize(base + (hi - lo), (0, 0));
     let mut w = base;

@@ -152,7 +152,12 @@ mod tests {
 
     #[test]
     fn encode_decode_round_trip() {
-        for c in [[0, 0, 0], [1, 2, 3], [MORTON_MAX, 0, 12345], [MORTON_MAX; 3]] {
+        for c in [
+            [0, 0, 0],
+            [1, 2, 3],
+            [MORTON_MAX, 0, 12345],
+            [MORTON_MAX; 3],
+        ] {
             assert_eq!(morton_decode(morton_encode(c)), c);
         }
         assert_eq!(morton_encode([1, 0, 0]), 1);

@@ -118,8 +118,14 @@ fn within(points: &[Point3], r: f64, cap: usize) -> Result<Csr> {
     };
     let grid = CellGrid::new(points, quant, &sorted, level);
     drop(sorted);
-    let shells = ((r / grid.cell_size) * (1.0 + 1e-9) + 1e-12).ceil().max(1.0);
-    let shells = if shells > 1e6 { i64::MAX } else { shells as i64 };
+    let shells = ((r / grid.cell_size) * (1.0 + 1e-9) + 1e-12)
+        .ceil()
+        .max(1.0);
+    let shells = if shells > 1e6 {
+        i64::MAX
+    } else {
+        shells as i64
+    };
     let r2 = r * r;
     let r2_bits = r2.to_bits();
     // Per task: (counts of its rows, concatenated rows), in Morton order.
