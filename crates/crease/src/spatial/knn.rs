@@ -362,9 +362,12 @@ impl Best {
 struct Scratch {
     /// Candidates as (squared distance bits, input index): for non-negative floats the bit
     /// patterns order like the values, so tuples sort by distance then index.
-    cands: Vec<(u64, u32)>,
-    /// The previous query of this thread and the distance to its k-th neighbour.
-    prev: Option<(Point3, f64)>,
+    /// (The third field is the candidate's sorted position.)
+    cands: Vec<(u64, u32, u32)>,
+    /// Sorted positions of the previous query of this thread and of its k neighbours.
+    prev: Vec<u32>,
+    /// Squared distances from the current query to the points of `prev`.
+    seed: Vec<u64>,
     /// The cell whose 3 x 3 x 3 block is in `near`.
     cell: Option<[i64; 3]>,
     /// Non-empty cells of that block: (cell, first, end) sorted positions.
@@ -381,17 +384,17 @@ fn scan(
     lo: usize,
     hi: usize,
     t2_bits: u64,
-    cands: &mut Vec<(u64, u32)>,
+    cands: &mut Vec<(u64, u32, u32)>,
 ) {
     let base = cands.len();
-    cands.resize(base + (hi - lo), (0, 0));
+    cands.resize(base + (hi - lo), (0, 0, 0));
     let mut w = base;
     let pts = &grid.points[lo..hi];
     let ids = &grid.ids[lo..hi];
     for (j, (p, &id)) in pts.iter().zip(ids).enumerate() {
         let d = dist2(q, p).to_bits();
         if let Some(slot) = cands.get_mut(w) {
-            *slot = (d, id);
+            *slot = (d, id, (lo + j) as u32);
         }
         w += usize::from(d <= t2_bits && lo + j != r);
     }
@@ -401,9 +404,10 @@ fn scan(
 /// Grid search for sorted point `r`, at most `max_shells` shells; writes the k nearest input
 /// indices to `row` and returns true, or false when unfinished.
 ///
-/// The previous query p of the same thread bounds the search: p and its k neighbours are k + 1
-/// points within `d_k(p) + |q - p|` of q, so at least k points other than q lie that close, and
-/// farther candidates and cells are skipped from the start. Consecutive queries (Morton order)
+/// The previous query p of the same thread bounds the search: among p and its k neighbours
+/// (k + 1 points) at least k differ from q, so the k-th smallest of their distances to q bounds
+/// q's k-th neighbour distance from above; farther candidates and cells are skipped from the
+/// start. Consecutive queries (Morton order) share most neighbours, so the bound is tight. Consecutive queries (Morton order)
 /// mostly share a cell, so the cell's 3 x 3 x 3 block is looked up once for all of them.
 fn grid_query(
     grid: &CellGrid,
@@ -415,14 +419,22 @@ fn grid_query(
 ) -> bool {
     let q = grid.points[r];
     let c = grid.cell_of(&q);
-    let mut t2 = match scratch.prev {
-        Some((p, dk)) => {
-            let b = (dk + dist2(&p, &q).sqrt()) * (1.0 + 1e-9);
-            b * b
+    let mut t2_bits = f64::INFINITY.to_bits();
+    if scratch.prev.len() > k {
+        scratch.seed.clear();
+        for &j in &scratch.prev {
+            if j as usize != r {
+                scratch
+                    .seed
+                    .push(dist2(&q, &grid.points[j as usize]).to_bits());
+            }
         }
-        None => f64::INFINITY,
-    };
-    let mut t2_bits = t2.to_bits();
+        if scratch.seed.len() >= k {
+            let (_, kth, _) = scratch.seed.select_nth_unstable(k - 1);
+            t2_bits = *kth;
+        }
+    }
+    let mut t2 = f64::from_bits(t2_bits);
     if scratch.cell != Some(c) {
         scratch.near.clear();
         for s in 0..=1 {
@@ -458,7 +470,9 @@ fn grid_query(
                 for (o, c) in row.iter_mut().zip(cands.iter()) {
                     *o = c.1;
                 }
-                scratch.prev = Some((q, t2.sqrt()));
+                scratch.prev.clear();
+                scratch.prev.push(r as u32);
+                scratch.prev.extend(cands.iter().map(|c| c.2));
                 return true;
             }
         } else if grid.covers_all(c, s) {
