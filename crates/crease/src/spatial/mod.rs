@@ -1,10 +1,15 @@
 //! Spatial queries: nearest neighbours over point sets, local Delaunay 1-rings, mesh k-rings.
 
+mod grid;
 mod kdtree;
 pub mod knn;
 pub mod mesh_rings;
+pub mod morton;
+pub mod radius;
 pub mod ring;
 
 pub use kdtree::KdIndex;
-pub use knn::{knn, Neighborhoods};
+pub use knn::{knn, knn_with, KnnMethod, Neighborhoods};
+pub use morton::morton_order;
+pub use radius::{knn_within, radius_neighbors};
 pub use ring::{delaunay_rings, RingParams, Rings};

@@ -1,0 +1,184 @@
+//! Morton (Z-order) codes of 3D points: 21 bits per axis, quantised over the bounding box.
+//!
+//! Sorting points by their code puts points that are close in space close in memory, which is
+//! what makes the all-points queries of [`super::knn`] cache friendly whatever the input order.
+
+use rayon::prelude::*;
+
+use crate::geometry::Point3;
+
+/// Bits per axis of a Morton code.
+pub const MORTON_BITS: u32 = 21;
+
+/// Largest quantised coordinate (2^21 - 1).
+pub const MORTON_MAX: u32 = (1 << MORTON_BITS) - 1;
+
+/// Spreads the low 21 bits of `v` so that bit i moves to bit 3i.
+#[inline]
+fn spread(v: u32) -> u64 {
+    let mut x = (v & MORTON_MAX) as u64;
+    x = (x | (x << 32)) & 0x001f_0000_0000_ffff;
+    x = (x | (x << 16)) & 0x001f_0000_ff00_00ff;
+    x = (x | (x << 8)) & 0x100f_00f0_0f00_f00f;
+    x = (x | (x << 4)) & 0x10c3_0c30_c30c_30c3;
+    x = (x | (x << 2)) & 0x1249_2492_4924_9249;
+    x
+}
+
+/// Inverse of [`spread`]: gathers bits 3i into bit i.
+#[inline]
+fn compact(v: u64) -> u32 {
+    let mut x = v & 0x1249_2492_4924_9249;
+    x = (x | (x >> 2)) & 0x10c3_0c30_c30c_30c3;
+    x = (x | (x >> 4)) & 0x100f_00f0_0f00_f00f;
+    x = (x | (x >> 8)) & 0x001f_0000_ff00_00ff;
+    x = (x | (x >> 16)) & 0x001f_0000_0000_ffff;
+    x = (x | (x >> 32)) & 0x1f_ffff;
+    x as u32
+}
+
+/// Interleaves three 21-bit coordinates (x in the lowest bit of each triple).
+#[inline]
+pub fn morton_encode(c: [u32; 3]) -> u64 {
+    spread(c[0]) | (spread(c[1]) << 1) | (spread(c[2]) << 2)
+}
+
+/// Inverse of [`morton_encode`].
+#[inline]
+pub fn morton_decode(code: u64) -> [u32; 3] {
+    [compact(code), compact(code >> 1), compact(code >> 2)]
+}
+
+/// Maps points to 21-bit integer coordinates over a cube containing their bounding box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quantizer {
+    /// Lower corner of the bounding box.
+    pub origin: Point3,
+    /// Size of one quantisation step (the cube's side / 2^21), > 0.
+    pub unit: f64,
+    inv_unit: f64,
+}
+
+impl Quantizer {
+    /// The quantiser of `points` (finite coordinates); `None` for an empty slice.
+    pub fn new(points: &[Point3]) -> Option<Self> {
+        let first = *points.first()?;
+        let (lo, hi) = points
+            .par_iter()
+            .fold(
+                || (first, first),
+                |(mut lo, mut hi), p| {
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(p[a]);
+                        hi[a] = hi[a].max(p[a]);
+                    }
+                    (lo, hi)
+                },
+            )
+            .reduce(
+                || (first, first),
+                |(mut lo, mut hi), (l, h)| {
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(l[a]);
+                        hi[a] = hi[a].max(h[a]);
+                    }
+                    (lo, hi)
+                },
+            );
+        let extent = (0..3).map(|a| hi[a] - lo[a]).fold(0.0f64, f64::max);
+        // A degenerate box (one point, or all points equal) still gets a positive unit.
+        let extent = if extent > 0.0 && extent.is_finite() {
+            extent
+        } else {
+            1.0
+        };
+        let unit = extent / (1u64 << MORTON_BITS) as f64;
+        Some(Quantizer {
+            origin: lo,
+            unit,
+            inv_unit: 1.0 / unit,
+        })
+    }
+
+    /// The side of the quantised cube (2^21 units).
+    pub fn extent(&self) -> f64 {
+        self.unit * (1u64 << MORTON_BITS) as f64
+    }
+
+    /// Integer coordinates of `p`, clamped to `0..=2^21-1`.
+    #[inline]
+    pub fn quantize(&self, p: &Point3) -> [u32; 3] {
+        let q = |a: usize| {
+            let v = (p[a] - self.origin[a]) * self.inv_unit;
+            // `as` saturates: negative and NaN give 0.
+            (v as u32).min(MORTON_MAX)
+        };
+        [q(0), q(1), q(2)]
+    }
+
+    /// The Morton code of `p`.
+    #[inline]
+    pub fn code(&self, p: &Point3) -> u64 {
+        morton_encode(self.quantize(p))
+    }
+}
+
+/// (Morton code, index) of every point, sorted by code then index (parallel sort).
+pub fn morton_sorted(points: &[Point3], quantizer: &Quantizer) -> Vec<(u64, u32)> {
+    let mut keys: Vec<(u64, u32)> = points
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| (quantizer.code(p), i as u32))
+        .collect();
+    keys.par_sort_unstable();
+    keys
+}
+
+/// The permutation that sorts `points` along the Morton curve of their bounding box (ties by
+/// index): `order[r]` is the input index of the point at rank `r`.
+pub fn morton_order(points: &[Point3]) -> Vec<u32> {
+    let Some(q) = Quantizer::new(points) else {
+        return Vec::new();
+    };
+    morton_sorted(points, &q)
+        .into_iter()
+        .map(|(_, i)| i)
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn encode_decode_round_trip() {
+        for c in [
+            [0, 0, 0],
+            [1, 2, 3],
+            [MORTON_MAX, 0, 12345],
+            [MORTON_MAX; 3],
+        ] {
+            assert_eq!(morton_decode(morton_encode(c)), c);
+        }
+        assert_eq!(morton_encode([1, 0, 0]), 1);
+        assert_eq!(morton_encode([0, 1, 0]), 2);
+        assert_eq!(morton_encode([0, 0, 1]), 4);
+        assert_eq!(morton_encode([2, 0, 0]), 8);
+    }
+
+    #[test]
+    fn order_is_a_permutation_grouping_octants() {
+        let pts: Vec<Point3> = (0..64)
+            .map(|i| [(i % 4) as f64, ((i / 4) % 4) as f64, (i / 16) as f64])
+            .collect();
+        let order = morton_order(&pts);
+        let mut seen = order.clone();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..64).collect::<Vec<u32>>());
+        // The first 8 points of the Z-order are the 2x2x2 block at the origin.
+        for &i in &order[..8] {
+            let p = pts[i as usize];
+            assert!(p[0] < 2.0 && p[1] < 2.0 && p[2] < 2.0, "{p:?}");
+        }
+    }
+}
