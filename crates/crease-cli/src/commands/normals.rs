@@ -86,7 +86,7 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
     let t_read = t_read.elapsed().as_secs_f64();
     let n = geom.points.len();
     let had_normals = geom.points.normals.is_some();
-    let needs_knn = a.method == Method::Pca || a.orient;
+    let needs_knn = a.method != Method::Mesh || a.orient;
     let mut t_knn = 0.0;
     let nbrs = if needs_knn {
         let stage = Stage::start(&format!("{} nearest neighbours", a.k), g.quiet);
@@ -113,9 +113,18 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
             )?
             .normals
         }
-        Method::Ring => anyhow::bail!(
-            "--method ring is not yet available in this build (use --method pca or mesh)"
-        ),
+        Method::Ring => {
+            let nbrs = nbrs
+                .as_ref()
+                .ok_or_else(|| anyhow::anyhow!("internal: no neighbourhoods for --method ring"))?;
+            let rings = crease::spatial::delaunay_rings(
+                &geom.points.positions,
+                nbrs,
+                &crease::spatial::RingParams { k: a.k },
+            )
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+            estimate::ring_normals(&geom.points.positions, &rings)
+        }
         Method::Mesh => {
             if !geom.is_mesh() {
                 return Err(crate::ui::usage(format!(
