@@ -344,48 +344,21 @@ pub(crate) fn least_axis(n: Point3) -> Point3 {
 }
 
 /// Unit eigenvector of the smallest eigenvalue of the symmetric matrix
-/// `[[a0, a1, a2], [a1, a3, a4], [a2, a4, a5]]`, in closed form: the eigenvalue from the
-/// trigonometric solution of the characteristic cubic (on the matrix scaled by its largest entry),
-/// the vector as the largest cross product of two rows of `A − λ I`. Accurate when the smallest
-/// eigenvalue is well separated from the others (a surface neighbourhood); `None` for a zero or
-/// non-finite matrix or a degenerate (line- or point-like) neighbourhood.
+/// `[[a0, a1, a2], [a1, a3, a4], [a2, a4, a5]]`, from the closed-form solver the PCA normals use
+/// ([`super::normals::smallest_eigen`]); `None` for a zero or non-finite matrix or a degenerate
+/// (line- or point-like) neighbourhood, where the smallest eigenvalue is not isolated and the
+/// plane normal is undefined.
 pub(crate) fn smallest_eigenvector(a: [f64; 6]) -> Option<Point3> {
     let s = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if !(s > 0.0 && s.is_finite()) {
         return None;
     }
-    let a = a.map(|v| v / s);
-    let q = (a[0] + a[3] + a[5]) / 3.0;
-    let p1 = a[1] * a[1] + a[2] * a[2] + a[4] * a[4];
-    let (b0, b3, b5) = (a[0] - q, a[3] - q, a[5] - q);
-    let p2 = b0 * b0 + b3 * b3 + b5 * b5 + 2.0 * p1;
-    let p = (p2 / 6.0).sqrt();
-    if p < 1e-12 {
-        return None; // isotropic: no preferred normal
-    }
-    // det(B) / 2 with B = (A − q I) / p.
-    let det = b0 * (b3 * b5 - a[4] * a[4]) - a[1] * (a[1] * b5 - a[4] * a[2])
-        + a[2] * (a[1] * a[4] - b3 * a[2]);
-    let r = (det / (2.0 * p * p * p)).clamp(-1.0, 1.0);
-    let phi = r.acos() / 3.0;
-    // Smallest root: q + 2p cos(φ + 2π/3).
-    let lambda = q + 2.0 * p * (phi + 2.0 * std::f64::consts::FRAC_PI_3).cos();
-    let r0 = [a[0] - lambda, a[1], a[2]];
-    let r1 = [a[1], a[3] - lambda, a[4]];
-    let r2 = [a[2], a[4], a[5] - lambda];
-    let (c01, c02, c12) = (cross(r0, r1), cross(r0, r2), cross(r1, r2));
-    let (d01, d02, d12) = (dot(c01, c01), dot(c02, c02), dot(c12, c12));
-    let best = if d01 >= d02 && d01 >= d12 {
-        c01
-    } else if d02 >= d12 {
-        c02
-    } else {
-        c12
-    };
-    if dot(best, best) < 1e-24 {
+    let (normal, [l0, l1, _]) = super::normals::smallest_eigen(a);
+    // λ0 ≈ λ1 (relative to the matrix scale): no preferred normal.
+    if (l1 - l0) <= 1e-12 * s {
         return None;
     }
-    normalize(best)
+    normal.iter().all(|v| v.is_finite()).then_some(normal)
 }
 
 /// First and second derivatives of a height function `z = f(x, y)` at the evaluation point.
