@@ -59,6 +59,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Estimate a normal per point (PCA, Delaunay 1-ring or mesh faces), optionally oriented.
     Normals(crate::commands::normals::NormalsArgs),
+    /// Sharp feature points (multi-scale projected distance with automatic thresholds).
+    Sharp(crate::commands::sharp::SharpArgs),
     /// Run every capability on a built-in synthetic part; no input files needed.
     Demo {
         /// Folder to write the results into.

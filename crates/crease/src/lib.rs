@@ -16,8 +16,10 @@ pub mod estimate;
 pub mod geometry;
 pub mod io;
 pub mod render;
+pub mod sharp;
 pub mod spatial;
 pub mod synth;
+pub mod threshold;
 
 pub use error::{Error, Result};
 pub use geometry::{Aabb, Attribute, PointCloud, TriMesh};

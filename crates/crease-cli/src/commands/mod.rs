@@ -6,6 +6,7 @@ mod demo;
 mod info;
 pub(crate) mod normals;
 mod render;
+pub(crate) mod sharp;
 mod synth;
 
 use std::path::Path;
@@ -30,6 +31,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Curvature(a) => curvature::run(g, &a),
         Command::Demo { output, n } => demo::run(g, &output, n),
         Command::Normals(a) => normals::run(g, &a),
+        Command::Sharp(a) => sharp::run(g, &a),
     }
 }
 

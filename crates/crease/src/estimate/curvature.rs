@@ -258,7 +258,7 @@ pub(crate) fn orient(c: PointCurvature, reference: Point3) -> PointCurvature {
 }
 
 /// The quadric fit at point `i` over the neighbours `row`.
-fn fit_point(points: &[Point3], i: usize, row: &[u32]) -> PointCurvature {
+pub(crate) fn fit_point(points: &[Point3], i: usize, row: &[u32]) -> PointCurvature {
     if row.len() < 5 {
         return PointCurvature::FAILED;
     }

@@ -61,6 +61,19 @@ pub fn k_ring_layers(
     set: &mut VertexSet,
     out: &mut Vec<u32>,
 ) {
+    k_ring_layers_with(topo, v, k, set, out, |_| {});
+}
+
+/// [`k_ring_layers`], calling `layer_end(len)` after each ring s = 1..=k is complete with the
+/// number of entries of rings 1..=s (called k times, also when the rings run out early).
+pub fn k_ring_layers_with(
+    topo: &MeshTopology,
+    v: u32,
+    k: usize,
+    set: &mut VertexSet,
+    out: &mut Vec<u32>,
+    mut layer_end: impl FnMut(usize),
+) {
     out.clear();
     set.clear();
     set.insert(v);
@@ -73,12 +86,10 @@ pub fn k_ring_layers(
         }
     }
     out.sort_unstable();
+    layer_end(out.len());
     let mut start = 0usize;
     for _ in 1..k {
         let end = out.len();
-        if start == end {
-            break;
-        }
         for i in start..end {
             let u = out[i];
             for n in topo.neighbors(u as usize) {
@@ -88,8 +99,45 @@ pub fn k_ring_layers(
             }
         }
         out[end..].sort_unstable();
+        layer_end(out.len());
         start = end;
     }
+}
+
+/// The k-rings of every vertex as in [`vertex_k_rings`], plus where each ring ends: entry
+/// `ends[v * k + (s - 1)]` is the number of entries of vertex v's row that lie within s edges,
+/// so the s-ring of v (s = 1..=k) is the first `ends[v * k + s - 1]` entries of its row.
+///
+/// Errors as [`vertex_k_rings`]; `k = 0` gives empty rows and no ends.
+pub fn vertex_k_rings_layered(topo: &MeshTopology, k: usize) -> Result<(Csr, Vec<u32>)> {
+    let nv = topo.num_vertices();
+    let rows: Vec<(Vec<u32>, Vec<u32>)> = (0..nv)
+        .into_par_iter()
+        .map_init(
+            || (VertexSet::default(), Vec::new()),
+            |(set, layers), v| {
+                let mut ends = Vec::with_capacity(k);
+                k_ring_layers_with(topo, v as u32, k, set, layers, |e| ends.push(e as u32));
+                (layers.clone(), ends)
+            },
+        )
+        .collect();
+    let total: usize = rows.iter().map(|r| r.0.len()).sum();
+    if total >= u32::MAX as usize {
+        return Err(Error::InvalidInput(format!(
+            "{k}-rings of {nv} vertices hold {total} entries, more than 32-bit offsets allow"
+        )));
+    }
+    let mut offsets = Vec::with_capacity(nv + 1);
+    let mut indices = Vec::with_capacity(total);
+    let mut ends = Vec::with_capacity(nv * k);
+    offsets.push(0u32);
+    for (r, e) in rows {
+        indices.extend_from_slice(&r);
+        offsets.push(indices.len() as u32);
+        ends.extend_from_slice(&e);
+    }
+    Ok((Csr { offsets, indices }, ends))
 }
 
 /// A set of vertex ids (open addressing, linear probing) that clears in time proportional to

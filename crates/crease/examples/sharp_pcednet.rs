@@ -1,0 +1,84 @@
+//! Scores the sharp-point detectors on the PCEDNet benchmark models in `../shared/data/points-gt`
+//! (median Matthews correlation coefficient of the sharp class, as the benchmark reports it).
+//!
+//! `cargo run --release -p crease --example sharp_pcednet -- [MEASURE] [raw] [q=0.99]`
+
+use std::path::PathBuf;
+
+use crease::io::{read, ReadOptions};
+use crease::sharp::{detect_points, Measure, SharpParams};
+
+fn mcc(pred: &[bool], truth: &[bool]) -> f64 {
+    let (mut tp, mut fp, mut tn, mut fnn) = (0f64, 0f64, 0f64, 0f64);
+    for (&p, &t) in pred.iter().zip(truth) {
+        match (p, t) {
+            (true, true) => tp += 1.0,
+            (true, false) => fp += 1.0,
+            (false, false) => tn += 1.0,
+            (false, true) => fnn += 1.0,
+        }
+    }
+    let d = ((tp + fp) * (tp + fnn) * (tn + fp) * (tn + fnn)).sqrt();
+    if d > 0.0 {
+        (tp * tn - fp * fnn) / d
+    } else {
+        0.0
+    }
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut params = SharpParams::default();
+    for a in &args {
+        if let Some(m) = Measure::ALL.iter().find(|m| m.name() == a) {
+            params.measure = *m;
+        } else if a == "raw" {
+            params.density_invariant = false;
+        } else if let Some(q) = a.strip_prefix("q=") {
+            params.otsu.upper_quantile = q.parse()?;
+        } else if let Some(s) = a.strip_prefix("scales=") {
+            params.scales = Some(s.split(',').map(|x| x.parse()).collect::<Result<_, _>>()?);
+        }
+    }
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/points-gt");
+    for set in ["abc", "abc-noisy", "default"] {
+        let mut names: Vec<_> = std::fs::read_dir(root.join(set))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .collect();
+        names.sort();
+        let mut mccs = Vec::new();
+        for path in names {
+            let (g, _) = read(&path, &ReadOptions::default())?;
+            let cloud = g.points;
+            let colors = cloud.colors.clone().ok_or("no colours")?;
+            let truth: Vec<bool> = colors
+                .iter()
+                .map(|c| matches!(c, [168, 0, 0] | [255, 0, 0]))
+                .collect();
+            let t = std::time::Instant::now();
+            let r = detect_points(&cloud.positions, &params)?;
+            let m = mcc(&r.sharp, &truth);
+            println!(
+                "{set}/{:<22} n={:>6} gt={:>5} pred={:>6} mcc={m:.3} ({:.2}s) T={:?}",
+                path.file_name().unwrap_or_default().to_string_lossy(),
+                truth.len(),
+                truth.iter().filter(|&&x| x).count(),
+                r.num_sharp(),
+                t.elapsed().as_secs_f64(),
+                r.scales
+                    .iter()
+                    .map(|s| (s.normalized_threshold * 1000.0).round() / 1000.0)
+                    .collect::<Vec<_>>()
+            );
+            mccs.push(m);
+        }
+        mccs.sort_by(f64::total_cmp);
+        let med = if mccs.len() % 2 == 1 {
+            mccs[mccs.len() / 2]
+        } else {
+            0.5 * (mccs[mccs.len() / 2 - 1] + mccs[mccs.len() / 2])
+        };
+        println!("{set}: median MCC {med:.3}\n");
+    }
+    Ok(())
+}
