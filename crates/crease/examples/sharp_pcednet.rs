@@ -32,6 +32,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for a in &args {
         if let Some(m) = Measure::ALL.iter().find(|m| m.name() == a) {
             params.measure = *m;
+        } else if a == "uniform" {
+            params.pca_weight = crease::estimate::PcaWeight::Uniform;
+        } else if a == "nothin" {
+            params.thin = false;
         } else if a == "raw" {
             params.density_invariant = false;
         } else if let Some(q) = a.strip_prefix("q=") {

@@ -10,7 +10,7 @@
 use rayon::prelude::*;
 
 use crate::estimate::curvature::fit_point;
-use crate::estimate::normals::weighted_pca;
+use crate::estimate::normals::{smallest_eigen, weighted_pca};
 use crate::estimate::PcaWeight;
 use crate::geometry::{vec3, Point3};
 
@@ -75,26 +75,43 @@ pub(crate) fn local_pca(
     weight: PcaWeight,
     scratch: &mut Vec<Point3>,
 ) -> LocalPca {
-    scratch.clear();
-    scratch.push(points[i]);
-    scratch.extend(row.iter().map(|&j| points[j as usize]));
-    let (mut normal, mut eigenvalues) = weighted_pca(scratch.as_mut_slice(), weight);
-    if let Some(keep) = own_sheet(scratch, normal) {
-        let p = points[i];
-        scratch.clear();
-        scratch.push(p);
-        scratch.extend(
-            row.iter()
-                .zip(keep)
-                .filter(|(_, k)| *k)
-                .map(|(&j, _)| points[j as usize]),
+    let mut coords = std::mem::take(scratch);
+    coords.clear();
+    coords.push(points[i]);
+    coords.extend(row.iter().map(|&j| points[j as usize]));
+    let mut work = Vec::with_capacity(coords.len());
+    let l = local_pca_coords(&coords, weight, &mut work);
+    *scratch = coords;
+    l
+}
+
+/// Weighted PCA of `coords` (`coords[0]` the point, then its neighbours), with the two-sheet
+/// test of [`own_sheet`] (whose tau selects the point's own sheet); `work` is scratch.
+#[inline]
+pub(crate) fn local_pca_coords(
+    coords: &[Point3],
+    weight: PcaWeight,
+    work: &mut Vec<Point3>,
+) -> LocalPca {
+    work.clear();
+    work.extend_from_slice(coords);
+    let (mut normal, mut eigenvalues) = weighted_pca(work.as_mut_slice(), weight);
+    if let Some(tau) = own_sheet(work, normal) {
+        // Keep the neighbours within tau of the point's offset along the normal.
+        let p = coords[0];
+        work.clear();
+        work.push(p);
+        work.extend(
+            coords[1..]
+                .iter()
+                .filter(|q| vec3::dot(vec3::sub(**q, p), normal).abs() <= tau),
         );
-        (normal, eigenvalues) = weighted_pca(scratch.as_mut_slice(), weight);
+        (normal, eigenvalues) = weighted_pca(work.as_mut_slice(), weight);
     }
-    let m = scratch.len() as f64;
+    let m = work.len() as f64;
     // weighted_pca centres the points in place on their plain centroid; the point came first.
-    let offset = scratch[0];
-    let rms_radius = (scratch.iter().map(|d| vec3::dot(*d, *d)).sum::<f64>() / m).sqrt();
+    let offset = work[0];
+    let rms_radius = (work.iter().map(|d| vec3::dot(*d, *d)).sum::<f64>() / m).sqrt();
     LocalPca {
         normal,
         eigenvalues,
@@ -103,8 +120,116 @@ pub(crate) fn local_pca(
     }
 }
 
+/// The projected distance or surface variation of one point at every scale at once:
+/// `coords[0]` is the point and `coords[1..]` its neighbours nearest first (at least the
+/// largest scale's count); `out[s]` receives the value over the point and its `scales[s]`
+/// nearest neighbours.
+#[inline]
+pub(crate) fn pca_measure_scales(
+    coords: &[Point3],
+    scales: &[usize],
+    measure: Measure,
+    weight: PcaWeight,
+    density_invariant: bool,
+    work: &mut Vec<Point3>,
+    out: &mut [f64],
+) {
+    if weight != PcaWeight::Uniform {
+        for (o, &k) in out.iter_mut().zip(scales) {
+            let l = local_pca_coords(&coords[..(k + 1).min(coords.len())], weight, work);
+            *o = pca_value(&l, None, measure, density_invariant);
+        }
+        return;
+    }
+    // Uniform weights: the nested neighbourhoods' moments are prefix sums, so every scale costs
+    // one 3 x 3 eigenproblem. Moments are taken about the point itself for precision.
+    let p = coords[0];
+    let (mut s1, mut s2) = ([0.0f64; 3], [0.0f64; 6]);
+    let mut next = 1usize;
+    for (o, &k) in out.iter_mut().zip(scales) {
+        let m = (k + 1).min(coords.len());
+        while next < m {
+            let d = vec3::sub(coords[next], p);
+            s1 = vec3::add(s1, d);
+            s2[0] += d[0] * d[0];
+            s2[1] += d[0] * d[1];
+            s2[2] += d[0] * d[2];
+            s2[3] += d[1] * d[1];
+            s2[4] += d[1] * d[2];
+            s2[5] += d[2] * d[2];
+            next += 1;
+        }
+        let inv = 1.0 / m as f64;
+        let c = vec3::scale(s1, inv);
+        let cov = [
+            s2[0] * inv - c[0] * c[0],
+            s2[1] * inv - c[0] * c[1],
+            s2[2] * inv - c[0] * c[2],
+            s2[3] * inv - c[1] * c[1],
+            s2[4] * inv - c[1] * c[2],
+            s2[5] * inv - c[2] * c[2],
+        ];
+        let (normal, eigenvalues) = smallest_eigen(cov);
+        let rms_radius = (cov[0] + cov[3] + cov[5]).max(0.0).sqrt();
+        let offset = vec3::scale(c, -1.0);
+        // The two-sheet test needs the points relative to the centroid.
+        let sheet = two_sheets(
+            coords[1..m]
+                .iter()
+                .map(|q| vec3::dot(vec3::sub(*q, p), normal)),
+        );
+        let l = if sheet.is_some() {
+            local_pca_coords(&coords[..m], weight, work)
+        } else {
+            LocalPca {
+                normal,
+                eigenvalues,
+                offset,
+                rms_radius,
+            }
+        };
+        *o = pca_value(&l, None, measure, density_invariant);
+    }
+}
+
+/// The projected distance (with `fixed_normal` instead of the PCA normal if given) or the
+/// surface variation of one neighbourhood.
+#[inline]
+fn pca_value(
+    l: &LocalPca,
+    fixed_normal: Option<Point3>,
+    measure: Measure,
+    density_invariant: bool,
+) -> f64 {
+    match measure {
+        Measure::SurfaceVariation => {
+            let e = l.eigenvalues;
+            let s = e[0] + e[1] + e[2];
+            if s > 0.0 {
+                e[0].max(0.0) / s
+            } else {
+                0.0
+            }
+        }
+        _ => {
+            let nrm = fixed_normal.unwrap_or(l.normal);
+            let d = vec3::dot(l.offset, nrm).abs();
+            if density_invariant {
+                if l.rms_radius > 0.0 {
+                    d / l.rms_radius
+                } else {
+                    0.0
+                }
+            } else {
+                d
+            }
+        }
+    }
+}
+
 /// Detects a neighbourhood made of two parallel sheets (the two faces of a plate thinner than
-/// the neighbourhood) and returns which neighbours lie on the point's own sheet.
+/// the neighbourhood) and returns tau: the neighbours whose offset |(q − p)·n| along the normal is at most tau lie on
+/// the point's own sheet.
 ///
 /// `centred[0]` is the point, `centred[1..]` its neighbours, all relative to their centroid;
 /// `normal` is their PCA normal. The offsets h_j = (p_j − p)·n split at half their largest
@@ -112,13 +237,18 @@ pub(crate) fn local_pca(
 /// (its offsets span less than half their mean), and the near group is flat too (offsets below a
 /// quarter of the far group's). Along a sharp edge the far face's offsets ramp from 0 to their
 /// maximum, so it fails the flatness test and the edge keeps its neighbours.
-fn own_sheet(centred: &[Point3], normal: Point3) -> Option<Vec<bool>> {
+fn own_sheet(centred: &[Point3], normal: Point3) -> Option<f64> {
     let p = *centred.first()?;
-    let h: Vec<f64> = centred[1..]
-        .iter()
-        .map(|q| vec3::dot(vec3::sub(*q, p), normal))
-        .collect();
-    let max = h.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    two_sheets(
+        centred[1..]
+            .iter()
+            .map(|q| vec3::dot(vec3::sub(*q, p), normal)),
+    )
+}
+
+/// The test of [`own_sheet`] on the offsets h_j = (p_j − p)·n of the neighbours.
+fn two_sheets(h: impl Iterator<Item = f64> + Clone) -> Option<f64> {
+    let max = h.clone().fold(0.0f64, |m, v| m.max(v.abs()));
     if max <= 0.0 {
         return None;
     }
@@ -131,7 +261,9 @@ fn own_sheet(centred: &[Point3], normal: Point3) -> Option<Vec<bool>> {
         0usize,
         0.0f64,
     );
-    for &v in &h {
+    let mut count = 0usize;
+    for v in h {
+        count += 1;
         if v.abs() > tau {
             lo = lo.min(v);
             hi = hi.max(v);
@@ -142,7 +274,7 @@ fn own_sheet(centred: &[Point3], normal: Point3) -> Option<Vec<bool>> {
             near_max = near_max.max(v.abs());
         }
     }
-    let near = h.len() - far;
+    let near = count - far;
     if far < 3 || near < 4 || (pos != 0 && pos != far) {
         return None;
     }
@@ -150,7 +282,7 @@ fn own_sheet(centred: &[Point3], normal: Point3) -> Option<Vec<bool>> {
     if hi - lo > 0.5 * mean || near_max > 0.25 * mean {
         return None;
     }
-    Some(h.iter().map(|v| v.abs() <= tau).collect())
+    Some(tau)
 }
 
 /// The measure of every point at one scale.
@@ -181,30 +313,7 @@ where
             .with_min_len(256)
             .map_init(Vec::new, |scratch, i| {
                 let l = local_pca(points, i, rows(i), weight, scratch);
-                match measure {
-                    Measure::SurfaceVariation => {
-                        let e = l.eigenvalues;
-                        let s = e[0] + e[1] + e[2];
-                        if s > 0.0 {
-                            e[0].max(0.0) / s
-                        } else {
-                            0.0
-                        }
-                    }
-                    _ => {
-                        let nrm = fixed_normals.map_or(l.normal, |f| f[i]);
-                        let d = vec3::dot(l.offset, nrm).abs();
-                        if density_invariant {
-                            if l.rms_radius > 0.0 {
-                                d / l.rms_radius
-                            } else {
-                                0.0
-                            }
-                        } else {
-                            d
-                        }
-                    }
-                }
+                pca_value(&l, fixed_normals.map(|f| f[i]), measure, density_invariant)
             })
             .collect(),
         Measure::NormalVariation => {
