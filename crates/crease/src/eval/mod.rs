@@ -239,7 +239,8 @@ pub fn check_same_points(
     let tol2 = tol * tol;
     let differs = |a: &Point3, b: &Point3| {
         let d2: f64 = (0..3).map(|k| (a[k] - b[k]) * (a[k] - b[k])).sum();
-        !(d2 <= tol2)
+        // NaN (a non-finite coordinate) counts as a difference.
+        d2.is_nan() || d2 > tol2
     };
     let Some(first) = pred
         .par_iter()
