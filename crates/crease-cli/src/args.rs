@@ -59,6 +59,9 @@ pub enum Command {
     Render(RenderArgs),
     /// Estimate a normal per point (PCA, Delaunay 1-ring or mesh faces), optionally oriented.
     Normals(crate::commands::normals::NormalsArgs),
+    /// Score a labelled output against ground truth: precision, recall, F1, MCC, IoU, tolerant
+    /// scores, ROC and AUC.
+    Eval(crate::commands::eval::EvalArgs),
     /// Run every capability on a built-in synthetic part; no input files needed.
     Demo {
         /// Folder to write the results into.

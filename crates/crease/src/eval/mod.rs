@@ -29,8 +29,8 @@ pub use tolerant::{
     default_tolerance, tolerant_scores, TolerantScores, DEFAULT_TOLERANCE_SPACINGS,
 };
 pub use truth::{
-    class_of_color, labels_from_property, read_truth, truth_from_colors, truth_from_property,
-    ClassCounts, GroundTruth, PointClass, TruthSource, DEFAULT_PROPERTIES,
+    class_of_color, labels_from_property, read_truth, scores_from_property, truth_from_colors,
+    truth_from_property, ClassCounts, GroundTruth, PointClass, TruthSource, DEFAULT_PROPERTIES,
 };
 
 /// Relative coordinate tolerance of [`check_same_points`]: 1e-6 × the bounding-box diagonal,

@@ -228,6 +228,27 @@ pub fn labels_from_property(
     Ok(a.values.iter().map(|&v| v > 0.0).collect())
 }
 
+/// The values of the numeric property `name` of `cloud` as scores (e.g. a detector's
+/// `sharpness`); errors (naming `path`) if it is missing or a value is NaN.
+pub fn scores_from_property(cloud: &PointCloud, name: &str, path: &Path) -> Result<Vec<f64>> {
+    let Some(a) = cloud.attribute(name) else {
+        return Err(Error::format(
+            path,
+            format!(
+                "no per-point property {name:?} for the scores; properties present: {}",
+                property_list(cloud)
+            ),
+        ));
+    };
+    if let Some(i) = a.values.iter().position(|v| v.is_nan()) {
+        return Err(Error::format(
+            path,
+            format!("score property {name:?} is NaN at point {i}; every score must be a number"),
+        ));
+    }
+    Ok(a.values.clone())
+}
+
 /// Ground truth from the numeric property `name` (> 0 = sharp). When `name` is `gt_sharp` and
 /// the cloud also has `gt_smooth` (a [`crate::synth`] part), classes are given too: sharp if
 /// `gt_sharp`, else smooth if `gt_smooth`, else flat.
