@@ -1,5 +1,5 @@
 //! Evaluation against ground truth: precision / recall / F1 / MCC / IoU of binary labels
-//! ([`metrics`]), ROC curve and AUC of a continuous score ([`roc`]), distance-tolerant precision
+//! ([`metrics`]), ROC curve and AUC of a continuous score ([`mod@roc`]), distance-tolerant precision
 //! and recall ([`tolerant`]), and ground-truth readers ([`truth`]).
 //!
 //! The inputs are per-item: a predicted and a true boolean label per item, optionally a score
