@@ -61,6 +61,9 @@ pub enum Command {
     Normals(crate::commands::normals::NormalsArgs),
     /// Sharp feature points (multi-scale projected distance with automatic thresholds).
     Sharp(crate::commands::sharp::SharpArgs),
+    /// Score a labelled output against ground truth: precision, recall, F1, MCC, IoU, tolerant
+    /// scores, ROC and AUC.
+    Eval(crate::commands::eval::EvalArgs),
     /// Run every capability on a built-in synthetic part; no input files needed.
     Demo {
         /// Folder to write the results into.

@@ -13,6 +13,7 @@
 
 pub mod error;
 pub mod estimate;
+pub mod eval;
 pub mod geometry;
 pub mod io;
 pub mod render;

@@ -3,6 +3,7 @@
 mod convert;
 pub mod curvature;
 mod demo;
+pub(crate) mod eval;
 mod info;
 pub(crate) mod normals;
 mod render;
@@ -32,6 +33,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Demo { output, n } => demo::run(g, &output, n),
         Command::Normals(a) => normals::run(g, &a),
         Command::Sharp(a) => sharp::run(g, &a),
+        Command::Eval(a) => eval::run(g, &a),
     }
 }
 
