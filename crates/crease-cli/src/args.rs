@@ -59,6 +59,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Estimate a normal per point (PCA, Delaunay 1-ring or mesh faces), optionally oriented.
     Normals(crate::commands::normals::NormalsArgs),
+    /// Closed sharp feature lines of a point cloud (Demarsin 2007 graph pipeline).
+    Lines(crate::commands::lines::LinesArgs),
     /// Sharp feature points (multi-scale projected distance with automatic thresholds).
     Sharp(crate::commands::sharp::SharpArgs),
     /// Score a labelled output against ground truth: precision, recall, F1, MCC, IoU, tolerant

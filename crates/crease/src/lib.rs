@@ -16,6 +16,7 @@ pub mod estimate;
 pub mod eval;
 pub mod geometry;
 pub mod io;
+pub mod lines;
 pub mod render;
 pub mod sharp;
 pub mod spatial;

@@ -5,6 +5,7 @@ pub mod curvature;
 mod demo;
 pub(crate) mod eval;
 mod info;
+pub(crate) mod lines;
 pub(crate) mod normals;
 mod render;
 pub(crate) mod sharp;
@@ -33,6 +34,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Demo { output, n } => demo::run(g, &output, n),
         Command::Normals(a) => normals::run(g, &a),
         Command::Sharp(a) => sharp::run(g, &a),
+        Command::Lines(a) => lines::run(g, &a),
         Command::Eval(a) => eval::run(g, &a),
     }
 }

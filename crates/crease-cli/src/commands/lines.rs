@@ -1,0 +1,134 @@
+//! `crease lines IN -o LINES.obj [--segmentation SEG.ply]`: closed sharp feature lines of a
+//! point cloud (Demarsin et al. 2007, `crease::lines`), written as polylines (OBJ `l`; PLY
+//! vertices plus an `edge` element), with per-stage graph sizes as the paper's Table 2.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use crease::geometry::{Attribute, PointCloud};
+use crease::io::Geometry;
+use crease::lines::{extract_lines, LinesParams};
+
+use crate::args::Global;
+use crate::ui::{usage, Stage};
+
+/// Arguments of `crease lines`.
+#[derive(Args, Debug)]
+pub struct LinesArgs {
+    /// Point cloud (a mesh's vertices are used as points).
+    pub input: PathBuf,
+    /// Output polylines (.obj writes `l` lines; .ply writes vertices and an `edge` element).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write the per-point cluster labels of the first-order segmentation (PLY property
+    /// `cluster`) to this file.
+    #[arg(long)]
+    pub segmentation: Option<PathBuf>,
+    /// Nearest neighbours triangulated for the Delaunay 1-rings.
+    #[arg(short, default_value_t = 20)]
+    pub k: usize,
+    /// Region-growing angle threshold between adjacent normals, degrees.
+    #[arg(long, default_value_t = 8.0)]
+    pub alpha_max: f64,
+    /// Maximum length of the branches pruned by Algorithm 2.
+    #[arg(long, default_value_t = 5)]
+    pub d_max: usize,
+    /// Candidates of the connect algorithm (default: chosen from the data).
+    #[arg(long)]
+    pub n: Option<usize>,
+    /// Shortest path allowed between two linked vertices (default: chosen from the data).
+    #[arg(long)]
+    pub d: Option<usize>,
+    /// Write text instead of binary where the format has both.
+    #[arg(long)]
+    pub ascii: bool,
+}
+
+pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
+    crease::io::Format::from_path(&a.output).map_err(|e| usage(e.to_string()))?;
+    crate::ui::ensure_not_input(&a.output, &[&a.input])?;
+    if let Some(s) = &a.segmentation {
+        crease::io::Format::from_path(s).map_err(|e| usage(e.to_string()))?;
+        crate::ui::ensure_not_input(s, &[&a.input])?;
+    }
+    if !(a.alpha_max > 0.0 && a.alpha_max < 90.0) {
+        return Err(usage(format!(
+            "--alpha-max must be in (0, 90) degrees, got {}",
+            a.alpha_max
+        )));
+    }
+    if a.k < 3 || a.d_max == 0 || a.n == Some(0) || a.d == Some(0) {
+        return Err(usage(
+            "-k must be at least 3, and --d-max, --n, --d positive".to_string(),
+        ));
+    }
+    let (geom, report) = super::load(g, &a.input)?;
+    let n_points = geom.points.len();
+    if n_points < a.k + 1 {
+        anyhow::bail!(
+            "{}: {n_points} points, sharp lines with -k {} need at least {}",
+            a.input.display(),
+            a.k,
+            a.k + 1
+        );
+    }
+    let params = LinesParams {
+        k: a.k,
+        alpha_max_degrees: a.alpha_max,
+        d_max: a.d_max,
+        n: a.n,
+        d: a.d,
+    };
+    let start = Instant::now();
+    let stage = Stage::start("sharp lines (Demarsin 2007)", g.quiet);
+    let net = extract_lines(&geom.points.positions, &params)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+    stage.finish();
+    let seconds = start.elapsed().as_secs_f64();
+    let mut out = Geometry::from_cloud(PointCloud::from_positions(net.vertices.clone()));
+    out.polylines = net.polylines.clone();
+    super::save(g, &a.output, &out, a.ascii, &[&a.input])?;
+    if let Some(path) = &a.segmentation {
+        let mut cloud = geom.points.clone();
+        cloud.set_attribute(Attribute::int(
+            "cluster",
+            net.segmentation.labels.iter().map(|&l| l as i64),
+        ))?;
+        super::save(g, path, &Geometry::from_cloud(cloud), a.ascii, &[&a.input])?;
+    }
+    if g.json {
+        let summary = serde_json::json!({
+            "input": a.input, "output": a.output, "points": n_points,
+            "dropped_nonfinite": report.dropped_nonfinite,
+            "clusters": net.segmentation.num_clusters(),
+            "small_clusters": net.small_clusters,
+            "stages": net.stages,
+            "close": net.close,
+            "n": net.n, "d": net.d,
+            "polylines": net.polylines.len(),
+            "closed_loops": net.closed_loops(),
+            "junctions": net.junctions(),
+            "endpoints": net.endpoints(),
+            "seconds": seconds,
+        });
+        crate::ui::print_json(&summary)?;
+    } else if !g.quiet {
+        eprintln!(
+            "wrote {}: {} polylines ({} closed loops), {} junctions, {} endpoints, {:.2} s",
+            a.output.display(),
+            net.polylines.len(),
+            net.closed_loops(),
+            net.junctions(),
+            net.endpoints(),
+            seconds
+        );
+        for s in &net.stages {
+            eprintln!(
+                "  {:<20} {:>8} vertices {:>8} edges  {:.3} s",
+                s.name, s.vertices, s.edges, s.seconds
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,450 @@
+//! Steps 2 to 6 of demarsin2007 (Algorithm 1): the cluster graph G_all (section 2.3), its
+//! extension G_extended (2.4), the pruned minimum spanning tree G_pruned_mst (2.5), branch
+//! pruning G_pruned_branches (2.6, Algorithm 2) and closing G_closed (2.7).
+//!
+//! The graph is small (one vertex per cluster, about one per point along the edges and one per
+//! face), so it is a plain adjacency list with sorted rows; every step visits vertices and
+//! edges in a fixed order, so results are deterministic.
+
+use crate::geometry::{vec3, Csr, Point3};
+use crate::spatial::KdIndex;
+
+/// An undirected graph over cluster vertices with sorted adjacency rows.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Graph {
+    adj: Vec<Vec<u32>>,
+}
+
+impl Graph {
+    /// A graph of `n` vertices and no edges.
+    pub fn new(n: usize) -> Self {
+        Graph {
+            adj: vec![Vec::new(); n],
+        }
+    }
+
+    /// Number of vertices (including isolated ones).
+    pub fn num_vertices(&self) -> usize {
+        self.adj.len()
+    }
+
+    /// Neighbours of `v`, sorted.
+    pub fn neighbors(&self, v: u32) -> &[u32] {
+        &self.adj[v as usize]
+    }
+
+    /// Degree of `v`.
+    pub fn degree(&self, v: u32) -> usize {
+        self.adj[v as usize].len()
+    }
+
+    /// True when `a` and `b` are adjacent.
+    pub fn has_edge(&self, a: u32, b: u32) -> bool {
+        self.adj[a as usize].binary_search(&b).is_ok()
+    }
+
+    /// Adds the edge a–b (no effect if present or a == b).
+    pub fn add_edge(&mut self, a: u32, b: u32) {
+        if a == b {
+            return;
+        }
+        if let Err(p) = self.adj[a as usize].binary_search(&b) {
+            self.adj[a as usize].insert(p, b);
+            if let Err(q) = self.adj[b as usize].binary_search(&a) {
+                self.adj[b as usize].insert(q, a);
+            }
+        }
+    }
+
+    /// Removes the edge a–b (no effect if absent).
+    pub fn remove_edge(&mut self, a: u32, b: u32) {
+        if let Ok(p) = self.adj[a as usize].binary_search(&b) {
+            self.adj[a as usize].remove(p);
+        }
+        if let Ok(q) = self.adj[b as usize].binary_search(&a) {
+            self.adj[b as usize].remove(q);
+        }
+    }
+
+    /// Edges `[a, b]` with a < b, sorted.
+    pub fn edges(&self) -> Vec<[u32; 2]> {
+        let mut out = Vec::new();
+        for (a, row) in self.adj.iter().enumerate() {
+            for &b in row {
+                if (a as u32) < b {
+                    out.push([a as u32, b]);
+                }
+            }
+        }
+        out
+    }
+
+    /// Number of edges.
+    pub fn num_edges(&self) -> usize {
+        self.adj.iter().map(Vec::len).sum::<usize>() / 2
+    }
+
+    /// Number of vertices with at least one edge.
+    pub fn num_active_vertices(&self) -> usize {
+        self.adj.iter().filter(|r| !r.is_empty()).count()
+    }
+
+    /// Length in edges of the shortest path from `a` to `b` if it is at most `limit`.
+    pub fn path_within(&self, a: u32, b: u32, limit: usize) -> Option<usize> {
+        if a == b {
+            return Some(0);
+        }
+        let mut frontier = vec![a];
+        let mut seen = vec![a];
+        for depth in 1..=limit {
+            let mut next = Vec::new();
+            for &v in &frontier {
+                for &w in self.neighbors(v) {
+                    if w == b {
+                        return Some(depth);
+                    }
+                    if !seen.contains(&w) {
+                        seen.push(w);
+                        next.push(w);
+                    }
+                }
+            }
+            if next.is_empty() {
+                return None;
+            }
+            frontier = next;
+        }
+        None
+    }
+}
+
+/// The clusters as graph vertices: centre of mass and size (section 2.3).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Clusters {
+    /// Centre of mass of every cluster (its representative point).
+    pub centers: Vec<Point3>,
+    /// Number of points of every cluster.
+    pub sizes: Vec<u32>,
+    /// Clusters smaller than the mean cluster size (section 2.3's heuristic).
+    pub small: Vec<bool>,
+}
+
+/// Step 2: G_all. Two clusters are adjacent when a point of one has a point of the other in its
+/// (symmetrised) 1-ring: their points' 1-ring neighbourhoods overlap.
+pub fn build_all(
+    points: &[Point3],
+    labels: &[u32],
+    sizes: &[u32],
+    adjacency: &Csr,
+) -> (Clusters, Graph) {
+    let m = sizes.len();
+    let mut sums = vec![[0.0f64; 3]; m];
+    for (p, &l) in points.iter().zip(labels) {
+        sums[l as usize] = vec3::add(sums[l as usize], *p);
+    }
+    let centers: Vec<Point3> = sums
+        .iter()
+        .zip(sizes)
+        .map(|(s, &c)| vec3::scale(*s, 1.0 / c.max(1) as f64))
+        .collect();
+    let mean = sizes.iter().map(|&s| s as f64).sum::<f64>() / m.max(1) as f64;
+    let small = sizes.iter().map(|&s| (s as f64) < mean).collect();
+    let mut pairs: Vec<[u32; 2]> = Vec::new();
+    for (p, &lp) in labels.iter().enumerate() {
+        if p >= adjacency.num_rows() {
+            break;
+        }
+        for &q in adjacency.row(p) {
+            let lq = labels[q as usize];
+            if lp < lq {
+                pairs.push([lp, lq]);
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    let mut g = Graph::new(m);
+    for [a, b] in pairs {
+        g.add_edge(a, b);
+    }
+    (
+        Clusters {
+            centers,
+            sizes: sizes.to_vec(),
+            small,
+        },
+        g,
+    )
+}
+
+/// Step 3: G_extended. Adds an edge between two small clusters that share two large
+/// neighbouring clusters, when their representatives are closer than the largest distance
+/// between two adjacent small clusters of G_all (section 2.4). Returns the number added.
+pub fn extend(clusters: &Clusters, g: &mut Graph) -> usize {
+    let m = clusters.sizes.len();
+    let dist =
+        |a: u32, b: u32| vec3::dist(clusters.centers[a as usize], clusters.centers[b as usize]);
+    let mut bound = 0.0f64;
+    for [a, b] in g.edges() {
+        if clusters.small[a as usize] && clusters.small[b as usize] {
+            bound = bound.max(dist(a, b));
+        }
+    }
+    // Group small clusters by each pair of large neighbours.
+    let mut keyed: Vec<([u32; 2], u32)> = Vec::new();
+    for s in 0..m as u32 {
+        if !clusters.small[s as usize] {
+            continue;
+        }
+        let large: Vec<u32> = g
+            .neighbors(s)
+            .iter()
+            .copied()
+            .filter(|&l| !clusters.small[l as usize])
+            .collect();
+        for i in 0..large.len() {
+            for j in i + 1..large.len() {
+                keyed.push(([large[i], large[j]], s));
+            }
+        }
+    }
+    keyed.sort_unstable();
+    let mut new_edges: Vec<[u32; 2]> = Vec::new();
+    let mut start = 0;
+    while start < keyed.len() {
+        let key = keyed[start].0;
+        let mut end = start;
+        while end < keyed.len() && keyed[end].0 == key {
+            end += 1;
+        }
+        // Sweep along x: only pairs closer than the bound can join.
+        let mut group: Vec<u32> = keyed[start..end].iter().map(|k| k.1).collect();
+        group.sort_by(|&a, &b| {
+            clusters.centers[a as usize][0]
+                .total_cmp(&clusters.centers[b as usize][0])
+                .then(a.cmp(&b))
+        });
+        for i in 0..group.len() {
+            let xi = clusters.centers[group[i] as usize][0];
+            for &t in &group[i + 1..] {
+                if clusters.centers[t as usize][0] - xi >= bound {
+                    break;
+                }
+                let s = group[i];
+                if dist(s, t) < bound && !g.has_edge(s, t) {
+                    new_edges.push([s.min(t), s.max(t)]);
+                }
+            }
+        }
+        start = end;
+    }
+    new_edges.sort_unstable();
+    new_edges.dedup();
+    for &[a, b] in &new_edges {
+        g.add_edge(a, b);
+    }
+    new_edges.len()
+}
+
+/// Step 4: the minimum spanning forest of G_extended with weights = distances between
+/// representatives, edges involving a large cluster weighted above every small–small edge
+/// (Kruskal; ties by vertex ids), then without the edges involving a large cluster:
+/// G_pruned_mst (section 2.5).
+pub fn pruned_mst(clusters: &Clusters, g: &Graph) -> Graph {
+    let m = g.num_vertices();
+    let mut edges: Vec<(bool, f64, [u32; 2])> = g
+        .edges()
+        .into_iter()
+        .map(|[a, b]| {
+            let large = !clusters.small[a as usize] || !clusters.small[b as usize];
+            (
+                large,
+                vec3::dist(clusters.centers[a as usize], clusters.centers[b as usize]),
+                [a, b],
+            )
+        })
+        .collect();
+    edges.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let mut parent: Vec<u32> = (0..m as u32).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            let y = p[x as usize];
+            p[x as usize] = p[y as usize];
+            x = y;
+        }
+        x
+    }
+    let mut out = Graph::new(m);
+    for (large, _, [a, b]) in edges {
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra == rb {
+            continue;
+        }
+        parent[ra.max(rb) as usize] = ra.min(rb);
+        if !large {
+            out.add_edge(a, b);
+        }
+    }
+    out
+}
+
+/// Depth of the branch that starts at `p` through its neighbour `q` (longest path from p into
+/// that side, in edges), capped at `cap`. The graph must be a forest.
+fn branch_depth(g: &Graph, p: u32, q: u32, cap: usize) -> usize {
+    // Iterative DFS with (vertex, parent, depth).
+    let mut best = 1;
+    let mut stack = vec![(q, p, 1usize)];
+    while let Some((v, parent, d)) = stack.pop() {
+        best = best.max(d);
+        if best >= cap {
+            return cap;
+        }
+        for &w in g.neighbors(v) {
+            if w != parent {
+                stack.push((w, v, d + 1));
+            }
+        }
+    }
+    best
+}
+
+/// Removes the branch from `p` through `q` (every vertex on q's side). Forest only.
+fn remove_branch(g: &mut Graph, p: u32, q: u32) {
+    let mut stack = vec![(q, p)];
+    let mut cut = Vec::new();
+    while let Some((v, parent)) = stack.pop() {
+        cut.push([parent, v]);
+        for &w in g.neighbors(v) {
+            if w != parent {
+                stack.push((w, v));
+            }
+        }
+    }
+    for [a, b] in cut {
+        g.remove_edge(a, b);
+    }
+}
+
+/// Step 5: Algorithm 2 with maximum branch length `d_max` (section 2.6), repeated until
+/// nothing changes. Returns the number of branches removed.
+pub fn prune_branches(g: &mut Graph, d_max: usize) -> usize {
+    let mut removed = 0;
+    loop {
+        let mut changed = false;
+        for p in 0..g.num_vertices() as u32 {
+            if g.degree(p) <= 2 {
+                continue;
+            }
+            let depths: Vec<(u32, usize)> = g
+                .neighbors(p)
+                .to_vec()
+                .into_iter()
+                .map(|q| (q, branch_depth(g, p, q, d_max)))
+                .collect();
+            let long = depths.iter().filter(|d| d.1 >= d_max).count();
+            let short: Vec<(u32, usize)> = depths.iter().copied().filter(|d| d.1 < d_max).collect();
+            if long >= 2 && !short.is_empty() {
+                for (q, _) in short {
+                    remove_branch(g, p, q);
+                    removed += 1;
+                }
+                changed = true;
+            } else if long == 1 && short.len() >= 2 {
+                // Keep only the deepest short branch (the lowest id on ties).
+                let keep = short
+                    .iter()
+                    .max_by(|a, b| a.1.cmp(&b.1).then(b.0.cmp(&a.0)))
+                    .map(|k| k.0);
+                for (q, _) in short {
+                    if Some(q) != keep {
+                        remove_branch(g, p, q);
+                        removed += 1;
+                    }
+                }
+                changed = true;
+            }
+        }
+        if !changed {
+            return removed;
+        }
+    }
+}
+
+/// What the closing step did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub struct CloseReport {
+    /// Endpoints before closing.
+    pub endpoints_before: usize,
+    /// Connections to another endpoint (case 1).
+    pub endpoint_links: usize,
+    /// Connections to an interior vertex (case 2).
+    pub interior_links: usize,
+    /// Edges removed by pruning the branches that still end.
+    pub pruned_edges: usize,
+}
+
+/// Step 6: the connect algorithm (section 2.7) for every endpoint, with the `n` nearest graph
+/// vertices as candidates and `d` the shortest acceptable path, then pruning of the branches
+/// that still end.
+pub fn close(clusters: &Clusters, g: &mut Graph, n: usize, d: usize) -> CloseReport {
+    let mut report = CloseReport::default();
+    let active: Vec<u32> = (0..g.num_vertices() as u32)
+        .filter(|&v| g.degree(v) > 0)
+        .collect();
+    if active.is_empty() {
+        return report;
+    }
+    let pts: Vec<Point3> = active
+        .iter()
+        .map(|&v| clusters.centers[v as usize])
+        .collect();
+    let Some(index) = KdIndex::new(&pts) else {
+        return report;
+    };
+    let endpoints: Vec<u32> = active
+        .iter()
+        .copied()
+        .filter(|&v| g.degree(v) == 1)
+        .collect();
+    report.endpoints_before = endpoints.len();
+    for p in endpoints {
+        if g.degree(p) != 1 {
+            continue; // linked from another endpoint already
+        }
+        let near: Vec<u32> = index
+            .nearest(&clusters.centers[p as usize], n + 1)
+            .into_iter()
+            .map(|(j, _)| active[j as usize])
+            .filter(|&q| q != p)
+            .take(n)
+            .collect();
+        let ok = |g: &Graph, q: u32| !g.has_edge(p, q) && g.path_within(p, q, d).is_none();
+        let ends: Vec<u32> = near.iter().copied().filter(|&q| g.degree(q) == 1).collect();
+        if !ends.is_empty() {
+            if let Some(&q) = ends.iter().find(|&&q| ok(g, q)) {
+                g.add_edge(p, q);
+                report.endpoint_links += 1;
+            }
+        } else if let Some(&q) = near.iter().find(|&&q| g.degree(q) > 1 && ok(g, q)) {
+            g.add_edge(p, q);
+            report.interior_links += 1;
+        }
+    }
+    // Prune every branch that still ends, back to its junction.
+    let mut stack: Vec<u32> = (0..g.num_vertices() as u32)
+        .filter(|&v| g.degree(v) == 1)
+        .collect();
+    stack.reverse();
+    while let Some(v) = stack.pop() {
+        if g.degree(v) != 1 {
+            continue;
+        }
+        let u = g.neighbors(v)[0];
+        g.remove_edge(v, u);
+        report.pruned_edges += 1;
+        if g.degree(u) == 1 {
+            stack.push(u);
+        }
+    }
+    report
+}
