@@ -40,6 +40,9 @@ pub struct LinesArgs {
     /// Shortest path allowed between two linked vertices (default: chosen from the data).
     #[arg(long)]
     pub d: Option<usize>,
+    /// Keep the clusters' centres of mass as vertices (skip step 7, the smoothing).
+    #[arg(long)]
+    pub no_smooth: bool,
     /// Write text instead of binary where the format has both.
     #[arg(long)]
     pub ascii: bool,
@@ -79,6 +82,7 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
         d_max: a.d_max,
         n: a.n,
         d: a.d,
+        smooth: !a.no_smooth,
     };
     let start = Instant::now();
     let stage = Stage::start("sharp lines (Demarsin 2007)", g.quiet);

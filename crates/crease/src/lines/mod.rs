@@ -23,11 +23,14 @@
 //! a few spacings), and d = 2 d_max = 10 edges, so that linking an endpoint never closes a
 //! cycle shorter than the branches Algorithm 2 already treats as noise.
 //!
-//! Not yet implemented: the smoothing of step 7 (section 2.8) and the cloud boundary in the
-//! network (Fig. 9); vertices are the clusters' centres of mass.
+//! 7. G_smooth: every vertex moved onto the local intersection of the smooth patches it
+//!    separates ([`smooth`], section 2.8, whose cited report is unavailable).
+//!
+//! Not yet implemented: the cloud boundary in the network (Fig. 9).
 
 pub mod graph;
 pub mod segment;
+pub mod smooth;
 
 use std::time::Instant;
 
@@ -54,6 +57,8 @@ pub struct LinesParams {
     pub n: Option<usize>,
     /// d of the connect algorithm; `None`: chosen from the data (see the module doc).
     pub d: Option<usize>,
+    /// Step 7: move the vertices onto the local intersections of the smooth patches.
+    pub smooth: bool,
 }
 
 impl Default for LinesParams {
@@ -64,6 +69,7 @@ impl Default for LinesParams {
             d_max: 5,
             n: None,
             d: None,
+            smooth: true,
         }
     }
 }
@@ -105,6 +111,8 @@ pub struct LineNetwork {
     pub n: usize,
     /// The d used.
     pub d: usize,
+    /// Vertex positions before smoothing (the clusters' centres of mass).
+    pub unsmoothed: Vec<Point3>,
 }
 
 impl LineNetwork {
@@ -212,6 +220,25 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
         .map(|[a, b]| [index[a as usize], index[b as usize]])
         .collect();
     let polylines = chain_segments(vertices.len(), &edges);
+    let t = Instant::now();
+    let unsmoothed = vertices.clone();
+    let vertices = if params.smooth {
+        smooth::smooth_vertices(
+            points,
+            &seg.labels,
+            &clusters.small,
+            &vertices,
+            3 * params.k,
+        )
+    } else {
+        vertices
+    };
+    stages.push(Stage {
+        name: "G_smooth",
+        vertices: vertices.len(),
+        edges: edges.len(),
+        seconds: t.elapsed().as_secs_f64(),
+    });
     let small_clusters = clusters.small.iter().filter(|&&s| s).count();
     Ok(LineNetwork {
         vertices,
@@ -224,5 +251,6 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
         close,
         n,
         d,
+        unsmoothed,
     })
 }
