@@ -31,11 +31,16 @@ fn seg_dist(p: Point3, a: Point3, b: Point3) -> f64 {
 /// (fraction of each sharp curve's samples within `tol` of the network, largest distance from
 /// a network vertex to the nearest sharp curve).
 fn coverage(part: &SyntheticPart, net: &LineNetwork, tol: f64) -> (Vec<f64>, f64) {
-    let sharp: Vec<_> = part
-        .curves
-        .iter()
-        .filter(|c| c.kind == CurveKind::Sharp)
-        .collect();
+    coverage_of(part, net, tol, CurveKind::Sharp)
+}
+
+fn coverage_of(
+    part: &SyntheticPart,
+    net: &LineNetwork,
+    tol: f64,
+    kind: CurveKind,
+) -> (Vec<f64>, f64) {
+    let sharp: Vec<_> = part.curves.iter().filter(|c| c.kind == kind).collect();
     let cover = sharp
         .iter()
         .map(|c| {
@@ -192,4 +197,36 @@ fn abc_nut_vertices() {
     assert_eq!(net.endpoints(), 0);
     assert!(recall >= 0.85, "recall {recall}");
     assert!(precision >= 0.98, "precision {precision}");
+}
+
+/// A cloud that is not a solid: the square patch's boundary joins the network (the paper's
+/// Fig. 9). Measured (20k points): 124 boundary points flagged by the 1-rings, linked into a
+/// loop around the square: every side covered, no endpoint, vertices within 0.95 spacings of
+/// the boundary; one corner is cut by a chord (2 junctions).
+#[test]
+fn plane_boundary() {
+    let p = part("plane", 20_000, 0.0);
+    let net = extract_lines(&p.cloud.positions, &LinesParams::default()).expect("lines");
+    let (cover, far) = coverage_of(&p, &net, 2.0 * p.spacing, CurveKind::Boundary);
+    println!(
+        "plane: {} boundary points, {} polylines, {} junctions, {} endpoints, coverage {cover:?}, farthest {:.2} spacings",
+        net.boundary_points,
+        net.polylines.len(),
+        net.junctions(),
+        net.endpoints(),
+        far / p.spacing
+    );
+    assert!(net.boundary_points > 50);
+    assert_eq!(net.endpoints(), 0);
+    assert!(cover.iter().all(|&c| c >= 0.9), "{cover:?}");
+    assert!(far <= 1.5 * p.spacing, "farthest {far}");
+    let none = extract_lines(
+        &p.cloud.positions,
+        &LinesParams {
+            boundary: false,
+            ..Default::default()
+        },
+    )
+    .expect("lines");
+    assert!(none.edges.is_empty(), "a plane has no sharp edge");
 }

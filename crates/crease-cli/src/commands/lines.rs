@@ -40,6 +40,9 @@ pub struct LinesArgs {
     /// Shortest path allowed between two linked vertices (default: chosen from the data).
     #[arg(long)]
     pub d: Option<usize>,
+    /// Leave the cloud's boundary out of the network.
+    #[arg(long)]
+    pub no_boundary: bool,
     /// Keep the clusters' centres of mass as vertices (skip step 7, the smoothing).
     #[arg(long)]
     pub no_smooth: bool,
@@ -83,6 +86,7 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
         n: a.n,
         d: a.d,
         smooth: !a.no_smooth,
+        boundary: !a.no_boundary,
     };
     let start = Instant::now();
     let stage = Stage::start("sharp lines (Demarsin 2007)", g.quiet);
@@ -107,6 +111,7 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
             "dropped_nonfinite": report.dropped_nonfinite,
             "clusters": net.segmentation.num_clusters(),
             "small_clusters": net.small_clusters,
+            "boundary_points": net.boundary_points,
             "stages": net.stages,
             "close": net.close,
             "n": net.n, "d": net.d,

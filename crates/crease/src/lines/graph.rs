@@ -448,3 +448,75 @@ pub fn close(clusters: &Clusters, g: &mut Graph, n: usize, d: usize) -> CloseRep
     }
     report
 }
+
+/// The cloud's boundary as a graph (demarsin2007 Fig. 9: "it has a boundary which we extract
+/// and include in the graph", just before the close step). Boundary points are those flagged by
+/// the Delaunay 1-ring (the point lies on the hull of its projected neighbours); two boundary
+/// points are linked when they are 1-ring neighbours. The minimum spanning forest of those
+/// links (weights = distances) with its short branches pruned by Algorithm 2 gives the
+/// boundary lines; the connect step later closes their gaps and joins them to the sharp lines.
+///
+/// Returns the boundary points (indices into `points`) and the graph over them (vertex i of
+/// the graph is `ids[i]`).
+pub fn boundary_graph(
+    points: &[Point3],
+    boundary: &[bool],
+    adjacency: &Csr,
+    d_max: usize,
+) -> (Vec<u32>, Graph) {
+    let ids: Vec<u32> = (0..points.len() as u32)
+        .filter(|&i| boundary[i as usize])
+        .collect();
+    let mut local = vec![u32::MAX; points.len()];
+    for (k, &i) in ids.iter().enumerate() {
+        local[i as usize] = k as u32;
+    }
+    let mut links: Vec<(f64, [u32; 2])> = Vec::new();
+    for (k, &i) in ids.iter().enumerate() {
+        if i as usize >= adjacency.num_rows() {
+            continue;
+        }
+        for &j in adjacency.row(i as usize) {
+            let l = local[j as usize];
+            if l != u32::MAX && (k as u32) < l {
+                links.push((
+                    vec3::dist(points[i as usize], points[j as usize]),
+                    [k as u32, l],
+                ));
+            }
+        }
+    }
+    links.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut parent: Vec<u32> = (0..ids.len() as u32).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            let y = p[x as usize];
+            p[x as usize] = p[y as usize];
+            x = y;
+        }
+        x
+    }
+    let mut g = Graph::new(ids.len());
+    for (_, [a, b]) in links {
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra != rb {
+            parent[ra.max(rb) as usize] = ra.min(rb);
+            g.add_edge(a, b);
+        }
+    }
+    prune_branches(&mut g, d_max);
+    (ids, g)
+}
+
+impl Graph {
+    /// Appends the vertices and edges of `other`, its vertex i becoming `self.num_vertices() + i`.
+    pub fn append(&mut self, other: &Graph) {
+        let base = self.adj.len() as u32;
+        self.adj.extend(
+            other
+                .adj
+                .iter()
+                .map(|row| row.iter().map(|&v| v + base).collect::<Vec<u32>>()),
+        );
+    }
+}

@@ -26,7 +26,9 @@
 //! 7. G_smooth: every vertex moved onto the local intersection of the smooth patches it
 //!    separates ([`smooth`], section 2.8, whose cited report is unavailable).
 //!
-//! Not yet implemented: the cloud boundary in the network (Fig. 9).
+//! Clouds that are not solids have a boundary: its points (flagged by the Delaunay 1-ring) are
+//! linked into lines and included in the graph just before the close step, as the paper does
+//! for Fig. 9 ([`graph::boundary_graph`]; on by default, [`LinesParams::boundary`]).
 
 pub mod graph;
 pub mod segment;
@@ -59,6 +61,8 @@ pub struct LinesParams {
     pub d: Option<usize>,
     /// Step 7: move the vertices onto the local intersections of the smooth patches.
     pub smooth: bool,
+    /// Include the cloud's boundary in the network (Fig. 9); default true.
+    pub boundary: bool,
 }
 
 impl Default for LinesParams {
@@ -70,6 +74,7 @@ impl Default for LinesParams {
             n: None,
             d: None,
             smooth: true,
+            boundary: true,
         }
     }
 }
@@ -92,8 +97,12 @@ pub struct Stage {
 pub struct LineNetwork {
     /// Positions of the network's vertices.
     pub vertices: Vec<Point3>,
-    /// The cluster each vertex stands for.
+    /// The cluster each vertex stands for (`u32::MAX` for a boundary point).
     pub vertex_clusters: Vec<u32>,
+    /// True for the vertices that are points of the cloud's boundary.
+    pub on_boundary: Vec<bool>,
+    /// Boundary points in the network before closing.
+    pub boundary_points: usize,
     /// Edges between vertices.
     pub edges: Vec<[u32; 2]>,
     /// The edges chained into polylines split at junctions; a closed loop repeats its first
@@ -167,13 +176,13 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
     drop(nbrs);
     let normals = ring_normals(points, &rings);
     let adjacency = rings.symmetrized();
+    let boundary_flags = rings.boundary.clone();
     drop(rings);
     let seg = region_grow(&normals, &adjacency, params.alpha_max_degrees.to_radians());
     let seg_seconds = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let (clusters, mut g) = graph::build_all(points, &seg.labels, &seg.sizes, &adjacency);
-    drop(adjacency);
+    let (mut clusters, mut g) = graph::build_all(points, &seg.labels, &seg.sizes, &adjacency);
     stages.push(Stage {
         name: "segmentation+G_all",
         vertices: g.num_active_vertices(),
@@ -197,6 +206,22 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
     let t = Instant::now();
     graph::prune_branches(&mut g, params.d_max);
     timed("G_pruned_branches", &g, t);
+    // The cloud's boundary joins the graph just before the close step (Fig. 9).
+    let num_clusters = g.num_vertices();
+    let mut boundary_points = 0;
+    if params.boundary && boundary_flags.iter().any(|&b| b) {
+        let t = Instant::now();
+        let (ids, bg) = graph::boundary_graph(points, &boundary_flags, &adjacency, params.d_max);
+        boundary_points = bg.num_active_vertices();
+        g.append(&bg);
+        for &i in &ids {
+            clusters.centers.push(points[i as usize]);
+            clusters.sizes.push(1);
+            clusters.small.push(true);
+        }
+        timed("boundary", &bg, t);
+    }
+    drop(adjacency);
     let n = params.n.unwrap_or(2 * params.d_max);
     let d = params.d.unwrap_or(2 * params.d_max);
     let t = Instant::now();
@@ -207,11 +232,14 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
     let mut index = vec![u32::MAX; g.num_vertices()];
     let mut vertices = Vec::new();
     let mut vertex_clusters = Vec::new();
+    let mut on_boundary = Vec::new();
     for v in 0..g.num_vertices() as u32 {
         if g.degree(v) > 0 {
             index[v as usize] = vertices.len() as u32;
             vertices.push(clusters.centers[v as usize]);
-            vertex_clusters.push(v);
+            let b = v as usize >= num_clusters;
+            vertex_clusters.push(if b { u32::MAX } else { v });
+            on_boundary.push(b);
         }
     }
     let edges: Vec<[u32; 2]> = g
@@ -243,6 +271,8 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
     Ok(LineNetwork {
         vertices,
         vertex_clusters,
+        on_boundary,
+        boundary_points,
         edges,
         polylines,
         segmentation: seg,
