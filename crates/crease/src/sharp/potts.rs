@@ -1,0 +1,190 @@
+//! Regularised sharp-point labels: a binary labelling of the kNN graph minimising, exactly by
+//! one minimum cut ([`crate::graphcut`]), the energy of vidal et al. 2011 (equation 1) with
+//! a data term from the per-point sharpness and a pairwise term over neighbouring points:
+//!
+//! E(x) = Σ_i D_i(x_i) + Σ_(i,j) [ λ w_ij [x_i ≠ x_j] − α a_ij [x_i = x_j = 1] ]
+//!
+//! * D_i(1) − D_i(0) = −`slope` · ln(sharpness_i): the decision of a lone point is the
+//!   detector's (sharp exactly when sharpness ≥ 1);
+//! * w_ij = exp(−d_ij² / 2h²) / W, h the mean neighbour distance of i and j, W the mean over
+//!   the points of Σ_j exp(…), so λ is the price of a point disagreeing with all its
+//!   neighbours, in units of ln(sharpness);
+//! * the reward a_ij (vidal's α_ee' of equations 3–4: consistent labelling of *aligned*
+//!   neighbours) is w_ij (|d̂_ij · e_i| |d̂_ij · e_j|)² l_i l_j, with e_i the local line direction
+//!   (principal axis of the neighbours weighted by their probability of being sharp) and l_i
+//!   its linearity 1 − σ₂/σ₁. It fills gaps along lines without a perimeter price across them.
+//!
+//! Both pairwise terms are submodular (V(0,0) + V(1,1) ≤ V(0,1) + V(1,0)), so the minimum is
+//! exact.
+
+use rayon::prelude::*;
+
+use crate::estimate::fit_plane;
+use crate::geometry::{vec3, Point3};
+use crate::graphcut::BinaryEnergy;
+use crate::spatial::Neighborhoods;
+use crate::{Error, Result};
+
+/// Parameters of the Potts regularisation of sharp points ([`super::SharpParams::regularize`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Regularize {
+    /// Neighbours per point in the graph (default 10).
+    pub k: usize,
+    /// λ: Potts price of a point disagreeing with all its neighbours, in units of
+    /// ln(sharpness) (see the module documentation).
+    pub lambda: f64,
+    /// α: reward of two sharp neighbours aligned with the local line direction, same units.
+    pub line_reward: f64,
+    /// Slope of the data term in ln(sharpness) (default 1).
+    pub slope: f64,
+    /// Neighbours giving the local line direction (default 16).
+    pub k_dir: usize,
+}
+
+impl Default for Regularize {
+    fn default() -> Self {
+        Regularize {
+            k: 10,
+            lambda: 0.5,
+            line_reward: 0.0,
+            slope: 1.0,
+            k_dir: 16,
+        }
+    }
+}
+
+/// The labelling minimising the energy of the module documentation from the per-point
+/// `sharpness` (≥ 1 exactly for the detector's sharp points).
+///
+/// Errors: parameters out of range, fewer neighbours in `nbrs` than `k` or `k_dir`.
+pub fn regularize(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    sharpness: &[f64],
+    params: &Regularize,
+) -> Result<Vec<bool>> {
+    let n = points.len();
+    if sharpness.len() != n || nbrs.len() != n {
+        return Err(Error::InvalidArgument(format!(
+            "sharp regularisation: {} sharpness values, {} neighbour lists for {n} points",
+            sharpness.len(),
+            nbrs.len()
+        )));
+    }
+    let k = params.k;
+    if k == 0 || k > nbrs.k() || params.k_dir > nbrs.k() {
+        return Err(Error::InvalidArgument(format!(
+            "sharp regularisation: k = {k} and k_dir = {} need 1 <= k and both <= {}",
+            params.k_dir,
+            nbrs.k()
+        )));
+    }
+    for (name, v) in [
+        ("lambda", params.lambda),
+        ("line_reward", params.line_reward),
+        ("slope", params.slope),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "sharp regularisation: {name} must be finite and >= 0, got {v}"
+            )));
+        }
+    }
+    let log_s: Vec<f64> = sharpness
+        .par_iter()
+        .map(|&s| s.clamp(1e-6, 1e6).ln())
+        .collect();
+    // Mean neighbour distance per point.
+    let h: Vec<f64> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let row = nbrs.prefix(i, k);
+            let s: f64 = row
+                .iter()
+                .map(|&j| vec3::dist(points[i], points[j as usize]))
+                .sum();
+            if row.is_empty() {
+                0.0
+            } else {
+                s / row.len() as f64
+            }
+        })
+        .collect();
+    let gauss = |i: usize, j: usize| {
+        let hh = 0.5 * (h[i] + h[j]);
+        if hh > 0.0 {
+            let d2 = vec3::dist2(points[i], points[j]);
+            (-d2 / (2.0 * hh * hh)).exp()
+        } else {
+            1.0
+        }
+    };
+    // Line direction and linearity per point (only needed with a line reward).
+    let dirs: Vec<(Point3, f64)> = if params.line_reward > 0.0 {
+        (0..n)
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|i| {
+                let prob = |j: usize| 1.0 / (1.0 + (-params.slope * log_s[j]).exp());
+                let items = std::iter::once(i as u32)
+                    .chain(nbrs.prefix(i, params.k_dir).iter().copied())
+                    .map(|j| (points[j as usize], prob(j as usize)));
+                match fit_plane(items) {
+                    Some(pl) if pl.eigenvalues[2] > 0.0 => {
+                        (pl.axes[2], 1.0 - pl.eigenvalues[1] / pl.eigenvalues[2])
+                    }
+                    _ => ([0.0; 3], 0.0),
+                }
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    // Undirected kNN edges with their weights.
+    let mut offsets = Vec::with_capacity(n + 1);
+    let mut indices = Vec::with_capacity(n * k);
+    offsets.push(0u32);
+    for i in 0..n {
+        indices.extend_from_slice(nbrs.prefix(i, k));
+        offsets.push(indices.len() as u32);
+    }
+    let graph = crate::geometry::Csr { offsets, indices };
+    let edges = crate::graphcut::undirected_edges(&graph);
+    let g_sum: Vec<f64> = edges
+        .par_iter()
+        .map(|&(i, j)| gauss(i as usize, j as usize))
+        .collect();
+    let norm = 2.0 * g_sum.iter().sum::<f64>() / n.max(1) as f64;
+    let norm = if norm > 0.0 { norm } else { 1.0 };
+    let mut e = BinaryEnergy::with_capacity(n, edges.len());
+    for (i, &l) in log_s.iter().enumerate() {
+        let d = params.slope * l;
+        // D(0) − D(1) = slope · ln(sharpness).
+        e.add_unary(i, d.max(0.0), (-d).max(0.0))?;
+    }
+    for (&(i, j), &g) in edges.iter().zip(&g_sum) {
+        let (i, j) = (i as usize, j as usize);
+        let w = g / norm;
+        let potts = params.lambda * w;
+        let reward = if params.line_reward > 0.0 {
+            let d = vec3::sub(points[j], points[i]);
+            let len = vec3::norm(d);
+            if len > 0.0 {
+                let (ei, li) = dirs[i];
+                let (ej, lj) = dirs[j];
+                let a = (vec3::dot(d, ei) / len).abs() * (vec3::dot(d, ej) / len).abs();
+                params.line_reward * w * a * a * li * lj
+            } else {
+                0.0
+            }
+        } else {
+            0.0
+        };
+        if reward > 0.0 {
+            e.add_pairwise(i, j, 0.0, potts, potts, -reward)?;
+        } else if potts > 0.0 {
+            e.add_potts(i, j, potts)?;
+        }
+    }
+    Ok(e.minimize().labels)
+}
