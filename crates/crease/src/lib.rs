@@ -15,6 +15,7 @@ pub mod error;
 pub mod estimate;
 pub mod eval;
 pub mod geometry;
+pub mod graphcut;
 pub mod io;
 pub mod lines;
 pub mod render;

@@ -1,0 +1,283 @@
+//! Regularised sharp-point labels: a binary labelling of the kNN graph minimising, exactly by
+//! one minimum cut ([`crate::graphcut`]), the energy of vidal et al. 2011 (equation 1) with
+//! a data term from the per-point sharpness and a pairwise term over neighbouring points:
+//!
+//! E(x) = Σ_i D_i(x_i) + Σ_(i,j) [ λ w_ij [x_i ≠ x_j] − α a_ij [x_i = x_j = 1] ]
+//!
+//! * D_i(1) − D_i(0) = −`slope` · ln(sharpness_i): the decision of a lone point is the
+//!   detector's (sharp exactly when sharpness ≥ 1);
+//! * w_ij = exp(−d_ij² / 2h²) / W, h the mean neighbour distance of i and j, W the mean over
+//!   the points of Σ_j exp(…), so λ is the price of a point disagreeing with all its
+//!   neighbours, in units of ln(sharpness);
+//! * the reward a_ij (vidal's α_ee' of equations 3–4: consistent labelling of *aligned*
+//!   neighbours) is w_ij (|d̂_ij · e_i| |d̂_ij · e_j|)² l_i l_j, with e_i the local line direction
+//!   (principal axis of the neighbours weighted by their probability of being sharp,
+//!   1 / (1 + sharpness^−slope)) and l_i
+//!   its linearity 1 − σ₂/σ₁. It fills gaps along lines without a perimeter price across them.
+//!
+//! Both pairwise terms are submodular (V(0,0) + V(1,1) ≤ V(0,1) + V(1,0)), so the minimum is
+//! exact.
+//!
+//! **Measured** (median MCC over the 8 PCEDNet ABC models, clean / noisy, thinning after the
+//! labelling unless "no thin"; `(k, λ, α, slope)`):
+//!
+//! | variant                      | clean | noisy |
+//! |------------------------------|-------|-------|
+//! | detector alone (default)     | 0.644 | 0.136 |
+//! | (10, 0.25, 0, 1)             | 0.642 | 0.157 |
+//! | (10, 0.5, 0, 1)              | 0.630 | 0.169 |
+//! | (10, 1, 0, 1)                | 0.366 | 0.149 |
+//! | (10, 2, 0, 1)                | 0.022 | 0.000 |
+//! | (10, 0.5, 0, 1), no thin     | 0.597 | 0.184 |
+//! | (10, 0.25, 0, 1), no thin    | 0.606 | 0.170 |
+//! | (16, 0.5, 0, 1)              | 0.629 | 0.169 |
+//! | (16, 0.5, 0, 1), no thin     | 0.600 | 0.185 |
+//! | (10, 0.5, 0, 2)              | 0.642 | 0.157 |
+//! | (10, 0.25, 0, 2)             | 0.637 | 0.147 |
+//! | (10, 0, 1, 1)                | 0.643 | 0.138 |
+//! | (10, 0.25, 1, 1)             | 0.639 | 0.159 |
+//! | (10, 0.25, 8, 1)             | 0.619 | 0.170 |
+//! | (10, 0.5, 2, 1)              | 0.627 | 0.178 |
+//! | (10, 0.5, 4, 1)              | 0.627 | 0.186 |
+//! | (10, 0.5, 4, 1), no thin     | 0.561 | 0.202 |
+//! | (10, 0.5, 8, 1)              | 0.613 | 0.199 |
+//! | (16, 0.5, 8, 1)              | 0.610 | 0.201 |
+//! | (10, 0.5, 8, 2)              | 0.630 | 0.162 |
+//! | (10, 0.5, 16, 1)             | 0.595 | 0.207 |
+//! | (10, 1, 16, 1)               | 0.587 | 0.231 |
+//!
+//! Pooling helps the noisy models (best median 0.231, from 0.136; per model 0133 0.22 → 0.41,
+//! 7023 0.20 → 0.38, 7029 0.30 → 0.38, 7010 0.12 → 0.23) but always costs on the clean ones
+//! (the Potts price erodes lines one or two points wide, which the reward only partly
+//! offsets), and stays far below the 0.40 hoped for: the per-point sharpness of the noisy
+//! models is too weak a data term. Weighting the line direction by max(0, ln sharpness)
+//! instead of the soft probability was worse (noisy 0.089–0.127). Hence not on by default.
+
+use rayon::prelude::*;
+
+use crate::estimate::fit_plane;
+use crate::geometry::{vec3, Point3};
+use crate::graphcut::BinaryEnergy;
+use crate::spatial::Neighborhoods;
+use crate::{Error, Result};
+
+/// Parameters of the Potts regularisation of sharp points ([`super::SharpParams::regularize`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Regularize {
+    /// Neighbours per point in the graph (default 10).
+    pub k: usize,
+    /// λ: Potts price of a point disagreeing with all its neighbours, in units of
+    /// ln(sharpness) (see the module documentation).
+    pub lambda: f64,
+    /// α: reward of two sharp neighbours aligned with the local line direction, same units.
+    pub line_reward: f64,
+    /// Slope of the data term in ln(sharpness) (default 1).
+    pub slope: f64,
+    /// Neighbours giving the local line direction (default 16).
+    pub k_dir: usize,
+}
+
+impl Default for Regularize {
+    fn default() -> Self {
+        Regularize {
+            k: 10,
+            lambda: 0.5,
+            line_reward: 0.0,
+            slope: 1.0,
+            k_dir: 16,
+        }
+    }
+}
+
+/// The labelling minimising the energy of the module documentation from the per-point
+/// `sharpness` (≥ 1 exactly for the detector's sharp points).
+///
+/// Errors: parameters out of range, fewer neighbours in `nbrs` than `k` or `k_dir`.
+pub fn regularize(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    sharpness: &[f64],
+    params: &Regularize,
+) -> Result<Vec<bool>> {
+    let n = points.len();
+    if sharpness.len() != n || nbrs.len() != n {
+        return Err(Error::InvalidArgument(format!(
+            "sharp regularisation: {} sharpness values, {} neighbour lists for {n} points",
+            sharpness.len(),
+            nbrs.len()
+        )));
+    }
+    let k = params.k;
+    if k == 0 || k > nbrs.k() || params.k_dir > nbrs.k() {
+        return Err(Error::InvalidArgument(format!(
+            "sharp regularisation: k = {k} and k_dir = {} need 1 <= k and both <= {}",
+            params.k_dir,
+            nbrs.k()
+        )));
+    }
+    for (name, v) in [
+        ("lambda", params.lambda),
+        ("line_reward", params.line_reward),
+        ("slope", params.slope),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "sharp regularisation: {name} must be finite and >= 0, got {v}"
+            )));
+        }
+    }
+    let log_s: Vec<f64> = sharpness
+        .par_iter()
+        .map(|&s| s.clamp(1e-6, 1e6).ln())
+        .collect();
+    // Mean neighbour distance per point.
+    let h: Vec<f64> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let row = nbrs.prefix(i, k);
+            let s: f64 = row
+                .iter()
+                .map(|&j| vec3::dist(points[i], points[j as usize]))
+                .sum();
+            if row.is_empty() {
+                0.0
+            } else {
+                s / row.len() as f64
+            }
+        })
+        .collect();
+    let gauss = |i: usize, j: usize| {
+        let hh = 0.5 * (h[i] + h[j]);
+        if hh > 0.0 {
+            let d2 = vec3::dist2(points[i], points[j]);
+            (-d2 / (2.0 * hh * hh)).exp()
+        } else {
+            1.0
+        }
+    };
+    // Line direction and linearity per point (only needed with a line reward).
+    let dirs: Vec<(Point3, f64)> = if params.line_reward > 0.0 {
+        (0..n)
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|i| {
+                let prob = |j: usize| 1.0 / (1.0 + (-params.slope * log_s[j]).exp());
+                let items = std::iter::once(i as u32)
+                    .chain(nbrs.prefix(i, params.k_dir).iter().copied())
+                    .map(|j| (points[j as usize], prob(j as usize)));
+                match fit_plane(items) {
+                    Some(pl) if pl.eigenvalues[2] > 0.0 => {
+                        (pl.axes[2], 1.0 - pl.eigenvalues[1] / pl.eigenvalues[2])
+                    }
+                    _ => ([0.0; 3], 0.0),
+                }
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    // Undirected kNN edges with their weights.
+    let mut offsets = Vec::with_capacity(n + 1);
+    let mut indices = Vec::with_capacity(n * k);
+    offsets.push(0u32);
+    for i in 0..n {
+        indices.extend_from_slice(nbrs.prefix(i, k));
+        offsets.push(indices.len() as u32);
+    }
+    let graph = crate::geometry::Csr { offsets, indices };
+    let edges = crate::graphcut::undirected_edges(&graph);
+    let g_sum: Vec<f64> = edges
+        .par_iter()
+        .map(|&(i, j)| gauss(i as usize, j as usize))
+        .collect();
+    let norm = 2.0 * g_sum.iter().sum::<f64>() / n.max(1) as f64;
+    let norm = if norm > 0.0 { norm } else { 1.0 };
+    let mut e = BinaryEnergy::with_capacity(n, edges.len());
+    for (i, &l) in log_s.iter().enumerate() {
+        let d = params.slope * l;
+        // D(0) − D(1) = slope · ln(sharpness).
+        e.add_unary(i, d.max(0.0), (-d).max(0.0))?;
+    }
+    for (&(i, j), &g) in edges.iter().zip(&g_sum) {
+        let (i, j) = (i as usize, j as usize);
+        let w = g / norm;
+        let potts = params.lambda * w;
+        let reward = if params.line_reward > 0.0 {
+            let d = vec3::sub(points[j], points[i]);
+            let len = vec3::norm(d);
+            if len > 0.0 {
+                let (ei, li) = dirs[i];
+                let (ej, lj) = dirs[j];
+                let a = (vec3::dot(d, ei) / len).abs() * (vec3::dot(d, ej) / len).abs();
+                params.line_reward * w * a * a * li * lj
+            } else {
+                0.0
+            }
+        } else {
+            0.0
+        };
+        if reward > 0.0 {
+            e.add_pairwise(i, j, 0.0, potts, potts, -reward)?;
+        } else if potts > 0.0 {
+            e.add_potts(i, j, potts)?;
+        }
+    }
+    Ok(e.minimize().labels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spatial::knn;
+
+    /// A 30 × 30 grid with a sharp line x = 15: isolated false detections are removed, the
+    /// line is kept (its gaps stay: the reward is too weak on this grid to pay for them).
+    #[test]
+    fn removes_isolated_points_and_fills_gaps() {
+        let (w, h) = (30usize, 30usize);
+        let points: Vec<Point3> = (0..w * h)
+            .map(|i| [(i % w) as f64, (i / w) as f64, 0.0])
+            .collect();
+        let on_line = |i: usize| i % w == 15;
+        let false_pos = [3 * w + 4, 10 * w + 25, 20 * w + 7, 26 * w + 22];
+        let gaps = [8 * w + 15, 17 * w + 15, 23 * w + 15];
+        let sharpness: Vec<f64> = (0..w * h)
+            .map(|i| {
+                if gaps.contains(&i) {
+                    0.6
+                } else if on_line(i) || false_pos.contains(&i) {
+                    3.0
+                } else {
+                    0.3
+                }
+            })
+            .collect();
+        let nbrs = knn(&points, 16).unwrap();
+        let params = Regularize {
+            lambda: 1.5,
+            line_reward: 8.0,
+            ..Default::default()
+        };
+        let labels = regularize(&points, &nbrs, &sharpness, &params).unwrap();
+        for (i, &l) in labels.iter().enumerate() {
+            let expected = on_line(i) && !gaps.contains(&i);
+            assert_eq!(l, expected, "point {i} ({}, {})", i % w, i / w);
+        }
+        // Without regularisation the false detections stay.
+        assert!(false_pos.iter().all(|&i| sharpness[i] > 1.0));
+        // λ = 0 and no reward: the detector's own decisions.
+        let plain = Regularize {
+            lambda: 0.0,
+            ..Default::default()
+        };
+        let labels = regularize(&points, &nbrs, &sharpness, &plain).unwrap();
+        assert!(labels.iter().zip(&sharpness).all(|(&l, &s)| l == (s > 1.0)));
+        // Errors.
+        let bad = Regularize {
+            k: 17,
+            ..Default::default()
+        };
+        assert!(regularize(&points, &nbrs, &sharpness, &bad).is_err());
+        assert!(regularize(&points, &nbrs, &sharpness[1..], &params).is_err());
+    }
+}
