@@ -88,21 +88,22 @@ fn report(name: &str, noise: f64, part: &SyntheticPart, net: &LineNetwork) -> (V
     (cover, far)
 }
 
-/// The cube: 12 edges meeting at 8 corners. Measured (20k points): with 1 % and 6 % noise
+/// The cube: 12 edges meeting at 8 corners. Measured (20k points): with 1, 6 and 10 % noise
 /// (of the spacing) 12 polylines, 8 junctions, no endpoint, every edge covered; after the
-/// smoothing every vertex lies within 0.09 / 0.19 spacings of an edge (2.4 before). Noiseless, one edge is lost: near two corners the spanning
+/// smoothing every vertex lies within 0.09 / 0.19 / 1.44 spacings of an edge (2.4 before). Noiseless, one edge is lost: near two corners the spanning
 /// tree joins it through a short parallel spur, the connect step finds no partner for the
 /// spur's end among its n nearest vertices and the pruning removes the spur with the edge
 /// (9 polylines, 6 junctions; an open problem of the closing step).
 #[test]
 fn cube_lines() {
-    for noise in [0.0, 0.01, 0.06] {
+    for noise in [0.0, 0.01, 0.06, 0.1] {
         let p = part("cube", 20_000, noise);
         let net = extract_lines(&p.cloud.positions, &LinesParams::default()).expect("lines");
         let (cover, far) = report("cube", noise, &p, &net);
         assert_eq!(cover.len(), 12);
         assert_eq!(net.endpoints(), 0, "closed lines have no endpoints");
-        assert!(far <= 0.3 * p.spacing, "farthest vertex {far}");
+        let max_far = if noise <= 0.06 { 0.3 } else { 2.0 };
+        assert!(far <= max_far * p.spacing, "farthest vertex {far}");
         let covered = cover.iter().filter(|&&c| c >= 0.98).count();
         if noise > 0.0 {
             assert_eq!(covered, 12);

@@ -115,6 +115,15 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
         &[],
     )?;
 
+    // 3b. Closed sharp feature lines (Demarsin 2007), written as OBJ polylines.
+    let s = Stage::start("closed sharp lines", g.quiet);
+    let net = crease::lines::extract_lines(pts, &Default::default())?;
+    time("sharp_lines", s);
+    let mut lines_geom =
+        crease::io::Geometry::from_cloud(crease::PointCloud::from_positions(net.vertices.clone()));
+    lines_geom.polylines = net.polylines.clone();
+    super::save(g, &dir.join("part-lines.obj"), &lines_geom, false, &[])?;
+
     // 4. The same part as a triangle mesh, and its sharp vertices over the 1- to 4-rings.
     let s = Stage::start("meshing the part", g.quiet);
     let m = synth::mesh(&shape, &MeshParams::default())?;
@@ -198,6 +207,19 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
     };
     crease::render::render_png(&scene, &params, &dir.join("part-detected-sharp.png"))?;
     let scene = Scene {
+        points: Some(&part.cloud),
+        mesh: None,
+        polylines: super::render::polylines_of(&lines_geom, 0),
+    };
+    let params = RenderParams {
+        color_by: ColorBy::Uniform,
+        title: Some(format!(
+            "{SHAPE}, {n} points - closed sharp lines (Demarsin 2007)"
+        )),
+        ..Default::default()
+    };
+    crease::render::render_png(&scene, &params, &dir.join("part-lines.png"))?;
+    let scene = Scene {
         points: None,
         mesh: Some(&m.mesh),
         polylines: super::render::polylines_of(&mesh_curves, 0),
@@ -233,6 +255,12 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
             "tolerant": tolerant,
             "mesh_vertices": { "detected": mesh_sharp.num_sharp(), "exact": mesh_confusion.metrics() },
         },
+        "sharp_lines": {
+            "polylines": net.polylines.len(),
+            "closed_loops": net.closed_loops(),
+            "junctions": net.junctions(),
+            "endpoints": net.endpoints(),
+        },
         "mesh": {
             "vertices": mesh_vertices,
             "faces": mesh_faces,
@@ -241,7 +269,7 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
         },
         "files": ["part.ply", "part.curves.ply", "part.truth.json", "part-estimated.ply",
                   "part-mesh.ply", "part-sharp.png", "part-surfaces.png", "part-curvature.png",
-                  "part-mesh.png", "part-detected-sharp.png"],
+                  "part-mesh.png", "part-detected-sharp.png", "part-lines.obj", "part-lines.png"],
         "seconds": timings,
     });
     std::fs::write(
@@ -280,6 +308,13 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
             confusion.f1(),
             tolerant.map_or(f64::NAN, |t| t.f1),
             mesh_confusion.f1()
+        );
+        println!(
+            "closed sharp lines (Demarsin 2007): {} polylines, {} closed loops, {} junctions, {} endpoints.",
+            net.polylines.len(),
+            net.closed_loops(),
+            net.junctions(),
+            net.endpoints()
         );
         println!("results in {}/: {}", dir.display(), result["files"]);
     }

@@ -520,3 +520,47 @@ impl Graph {
         );
     }
 }
+
+/// Marks the small clusters that lie between two smooth patches: those from which at least two
+/// distinct large clusters are reached within `hops` steps of G_all through small clusters.
+///
+/// A sharp edge is "the border between two large clusters" (section 2.4). With noise, the
+/// 1-ring normals of a flat face scatter beyond α_max here and there and the face's large
+/// cluster is sprinkled with islands of small clusters (section 3: "small clusters are created
+/// at the noisy parts"); such islands see only their own face's large cluster, and the spanning
+/// tree would otherwise wire them into spurious lines across the face.
+pub fn between_patches(clusters: &Clusters, g: &Graph, hops: usize) -> Vec<bool> {
+    let m = g.num_vertices();
+    let mut out = vec![false; m];
+    let mut seen: Vec<u32> = Vec::new();
+    for s in 0..m as u32 {
+        if !clusters.small[s as usize] {
+            continue;
+        }
+        let mut large: Vec<u32> = Vec::new();
+        seen.clear();
+        seen.push(s);
+        let mut frontier = vec![s];
+        'search: for _ in 0..hops {
+            let mut next = Vec::new();
+            for &v in &frontier {
+                for &w in g.neighbors(v) {
+                    if !clusters.small[w as usize] {
+                        if !large.contains(&w) {
+                            large.push(w);
+                            if large.len() >= 2 {
+                                break 'search;
+                            }
+                        }
+                    } else if !seen.contains(&w) {
+                        seen.push(w);
+                        next.push(w);
+                    }
+                }
+            }
+            frontier = next;
+        }
+        out[s as usize] = large.len() >= 2;
+    }
+    out
+}
