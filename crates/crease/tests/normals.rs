@@ -2,6 +2,7 @@
 //! and cylinder clouds with and without noise, mesh vertex normals on a sphere mesh, Hoppe
 //! orientation on closed shapes, determinism across thread counts, and argument errors.
 
+use crease::estimate::normals::pca_normals_direct;
 use crease::estimate::{
     estimate_normals, mesh_vertex_normals, orient_normals, pca_normals, PcaParams, PcaWeight,
     Weighting,
@@ -314,6 +315,54 @@ fn deterministic_across_thread_counts() {
     let (r2, o2) = run(2);
     assert_eq!(r1, r2);
     assert_eq!(o1, o2);
+    // The fused search + PCA gives exactly the same result, whatever the thread count.
+    for t in [1, 2, 3] {
+        let d = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+            .install(|| pca_normals_direct(pts, &PcaParams::default()).unwrap());
+        assert_eq!(d, r1, "{t} threads");
+    }
+}
+
+#[test]
+fn direct_equals_knn_then_pca() {
+    for (shape, noise) in [("cube", 0.2), ("fillet-chamfer-cone", 0.0), ("plane", 0.5)] {
+        let part = sample(shape, 8000, noise);
+        let pts = &part.cloud.positions;
+        let nbrs = knn(pts, 24).unwrap();
+        for k in [6, 20, 24] {
+            for weight in [
+                PcaParams::default().weight,
+                PcaWeight::Uniform,
+                PcaWeight::GaussianFixed(0.05),
+            ] {
+                let params = PcaParams { k, weight };
+                assert_eq!(
+                    pca_normals_direct(pts, &params).unwrap(),
+                    pca_normals(pts, &nbrs, &params).unwrap(),
+                    "{shape} k = {k} {weight:?}"
+                );
+            }
+        }
+    }
+    let part = sample("plane", 100, 0.0);
+    let pts = &part.cloud.positions;
+    let bad = PcaParams {
+        k: 20,
+        weight: PcaWeight::GaussianRelative(0.0),
+    };
+    assert!(pca_normals_direct(pts, &bad).is_err());
+    assert!(pca_normals_direct(
+        pts,
+        &PcaParams {
+            k: 0,
+            ..Default::default()
+        }
+    )
+    .is_err());
+    assert!(pca_normals_direct(&pts[..20], &PcaParams::default()).is_err());
 }
 
 #[test]

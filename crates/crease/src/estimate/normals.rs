@@ -36,7 +36,8 @@
 use rayon::prelude::*;
 
 use crate::geometry::{vec3, Point3, TriMesh};
-use crate::spatial::{knn, Neighborhoods};
+use crate::spatial::knn::knn_map;
+use crate::spatial::Neighborhoods;
 use crate::{Error, Result};
 
 /// The weights μ_j of equation 1.
@@ -105,13 +106,7 @@ pub fn pca_normals(
     if params.k == 0 {
         return Err(Error::InvalidArgument("PCA normals with k = 0".into()));
     }
-    if let PcaWeight::GaussianFixed(s) | PcaWeight::GaussianRelative(s) = params.weight {
-        if !(s.is_finite() && s > 0.0) {
-            return Err(Error::InvalidArgument(format!(
-                "PCA normals: Gaussian sigma must be positive and finite, got {s}"
-            )));
-        }
-    }
+    check_weight(params.weight)?;
     if params.k > nbrs.k() {
         return Err(Error::InvalidArgument(format!(
             "PCA normals with k = {} from neighbourhoods of only {} neighbours",
@@ -152,13 +147,53 @@ pub fn pca_normals(
     })
 }
 
-/// Convenience: the k nearest neighbours ([`knn`]) then [`pca_normals`] with default weights.
-/// Errors as `knn` (k = 0, fewer than k + 1 points).
-pub fn estimate_normals(points: &[Point3], k: usize) -> Result<Vec<Point3>> {
-    let nbrs = knn(points, k)?;
-    Ok(pca_normals(
+/// Weighted-PCA normals (tran equation 1) of every point over its `params.k` nearest neighbours,
+/// searched on the fly: the same result as [`knn`](crate::spatial::knn()) followed by [`pca_normals`], without storing
+/// the neighbour lists (the neighbourhoods are visited in spatial order by
+/// [`crate::spatial::knn::knn_map`], which is also several times more cache friendly than
+/// [`pca_normals`]' input-order traversal).
+///
+/// Errors as [`knn`](crate::spatial::knn()) (k = 0, fewer than k + 1 points, a non-finite coordinate) and on a Gaussian
+/// sigma that is not positive and finite.
+pub fn pca_normals_direct(points: &[Point3], params: &PcaParams) -> Result<PcaResult> {
+    check_weight(params.weight)?;
+    let k = params.k;
+    let weight = params.weight;
+    let fits: Vec<(Point3, [f64; 3])> = knn_map(
         points,
-        &nbrs,
+        k,
+        || Vec::with_capacity(k + 1),
+        |scratch: &mut Vec<Point3>, q| {
+            scratch.clear();
+            scratch.push(q.point);
+            scratch.extend_from_slice(q.neighbors);
+            weighted_pca(scratch.as_mut_slice(), weight)
+        },
+    )?;
+    let (normals, eigenvalues) = fits.into_par_iter().unzip();
+    Ok(PcaResult {
+        normals,
+        eigenvalues,
+    })
+}
+
+/// Errors on a Gaussian sigma that is not positive and finite.
+fn check_weight(weight: PcaWeight) -> Result<()> {
+    if let PcaWeight::GaussianFixed(s) | PcaWeight::GaussianRelative(s) = weight {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "PCA normals: Gaussian sigma must be positive and finite, got {s}"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Convenience: PCA normals over the k nearest neighbours with default weights
+/// ([`pca_normals_direct`]). Errors as [`knn`](crate::spatial::knn()) (k = 0, fewer than k + 1 points).
+pub fn estimate_normals(points: &[Point3], k: usize) -> Result<Vec<Point3>> {
+    Ok(pca_normals_direct(
+        points,
         &PcaParams {
             k,
             ..Default::default()

@@ -48,6 +48,8 @@
 //! build 0.53 ms / 8.6 ms / 286 ms and Morton order 0.46 / 6.2 / 113 ms at 10k / 100k / 1M;
 //! radius search (r = 2.5 x the spacing, about 20 neighbours) at 100k: 262 / 231 ms.
 
+use std::sync::OnceLock;
+
 use rayon::prelude::*;
 
 use super::grid::{dist2, CellGrid};
@@ -211,59 +213,175 @@ pub fn knn_with(points: &[Point3], k: usize, method: KnnMethod) -> Result<Neighb
             gather_fixed(&buf, &ids, k)
         }
         KnnMethod::Grid => {
-            let quant =
-                Quantizer::new(points).ok_or_else(|| Error::InvalidInput("empty".into()))?;
-            let sorted = morton_sorted(points, &quant);
-            let r = estimate_kth_distance(points, &sorted, k);
-            let level = level_for(&quant, r * CELL_RATIO);
-            let grid = CellGrid::new(points, quant, &sorted, level);
-            drop(sorted);
+            let search = GridSearch::new(points, k)?;
             let mut buf = vec![0u32; n * k];
-            let done: Vec<bool> = buf
-                .par_chunks_mut(k)
-                .enumerate()
-                .map_init(Scratch::default, |scratch, (r, row)| {
-                    grid_query(&grid, r, k, MAX_SHELLS, scratch, row)
-                })
-                .collect();
-            let failed: Vec<usize> = done
-                .par_iter()
-                .enumerate()
-                .filter_map(|(r, ok)| (!ok).then_some(r))
-                .collect();
-            if !failed.is_empty() {
-                let index = KdIndex::new(&grid.points);
-                let rows: Vec<Vec<u32>> = failed
-                    .par_iter()
-                    .map_init(
-                        || (Best::default(), Scratch::default()),
-                        |(best, scratch), &r| {
-                            let mut row = vec![0u32; k];
-                            match &index {
-                                Some(index) => {
-                                    best.reset(k);
-                                    kd_query(index, &grid.points, &grid.ids, r, best);
-                                    row.copy_from_slice(&best.id);
-                                }
-                                None => {
-                                    grid_query(&grid, r, k, i64::MAX, scratch, &mut row);
-                                }
-                            }
-                            row
-                        },
-                    )
-                    .collect();
-                for (&r, row) in failed.iter().zip(rows) {
-                    buf[r * k..(r + 1) * k].copy_from_slice(&row);
-                }
-            }
-            gather_fixed(&buf, &grid.ids, k)
+            buf.par_chunks_mut(k * TASK).enumerate().for_each_init(
+                Scratch::default,
+                |scratch, (t, rows)| {
+                    for (j, row) in rows.chunks_exact_mut(k).enumerate() {
+                        search.query(t * TASK + j, scratch);
+                        row.copy_from_slice(&scratch.ids);
+                    }
+                },
+            );
+            gather_fixed(&buf, &search.grid.ids, k)
         }
     };
     Ok(Neighborhoods::from_csr(
         k,
         Csr::from_fixed_width(n, k, indices),
     ))
+}
+
+/// Queries per parallel task: consecutive queries in Morton order share cells and most of their
+/// neighbours, so each task walks a long run of them with one scratch.
+const TASK: usize = 1024;
+
+/// One query's neighbourhood, handed to the closure of [`knn_map`].
+///
+/// The slices are the query's k nearest other points, nearest first, ties by input index:
+/// exactly the row [`knn`] returns for `index`, with the coordinates and squared distances
+/// alongside.
+#[derive(Debug, Clone, Copy)]
+pub struct KnnQuery<'a> {
+    /// Input index of the query point.
+    pub index: usize,
+    /// The query point.
+    pub point: Point3,
+    /// Coordinates of its k nearest neighbours, nearest first (the point itself excluded).
+    pub neighbors: &'a [Point3],
+    /// Input indices of the neighbours, same order.
+    pub ids: &'a [u32],
+    /// Squared distances from the query to the neighbours, same order (non-decreasing).
+    pub dist2: &'a [f64],
+}
+
+/// Calls `f` on the k-nearest-neighbour neighbourhood of every point and returns its results in
+/// input order, without storing the n·k neighbour lists.
+///
+/// The queries run in parallel in Morton order (see the module doc), so each neighbourhood is
+/// handed to `f` while its points are in cache; `init` makes one scratch value per parallel task
+/// (reused across that task's queries, e.g. buffers for a local fit). The neighbourhoods are the
+/// rows of [`knn`] (exact, nearest first, ties by input index), and the result does not depend on
+/// the thread count as long as `f`'s result depends only on its [`KnnQuery`] (not on the
+/// scratch's history).
+///
+/// Errors as [`knn`]: k = 0, fewer than k + 1 points, a non-finite coordinate.
+pub fn knn_map<T, S, I, F>(points: &[Point3], k: usize, init: I, f: F) -> Result<Vec<T>>
+where
+    T: Send,
+    I: Fn() -> S + Sync + Send,
+    F: Fn(&mut S, &KnnQuery) -> T + Sync + Send,
+{
+    check_knn_args(points, k)?;
+    let search = GridSearch::new(points, k)?;
+    let grid = &search.grid;
+    let in_rank_order: Vec<T> = (0..points.len())
+        .into_par_iter()
+        .with_min_len(TASK)
+        .map_init(
+            || (Scratch::default(), init()),
+            |(scratch, state), r| {
+                search.query(r, scratch);
+                let query = KnnQuery {
+                    index: grid.ids[r] as usize,
+                    point: grid.points[r],
+                    neighbors: &scratch.pts,
+                    ids: &scratch.ids,
+                    dist2: &scratch.d2,
+                };
+                f(state, &query)
+            },
+        )
+        .collect();
+    Ok(permute_to_input_order(in_rank_order, &grid.ids))
+}
+
+/// Moves `items[r]` to position `ids[r]` (`ids` is a permutation of `0..items.len()`), in place
+/// by following the permutation's cycles.
+fn permute_to_input_order<T>(mut items: Vec<T>, ids: &[u32]) -> Vec<T> {
+    let mut dest: Vec<u32> = ids.to_vec();
+    for i in 0..items.len() {
+        loop {
+            let d = dest[i] as usize;
+            if d == i || d >= items.len() {
+                break;
+            }
+            items.swap(i, d);
+            dest.swap(i, d);
+        }
+    }
+    items
+}
+
+/// The grid search over one cloud: the Morton-sorted points bucketed in cells, and the k-d tree
+/// fallback for queries the grid cannot finish in a few shells, built on first use.
+struct GridSearch<'a> {
+    points: &'a [Point3],
+    grid: CellGrid,
+    k: usize,
+    fallback: OnceLock<Option<KdIndex>>,
+}
+
+impl<'a> GridSearch<'a> {
+    /// Sorts and buckets `points` (arguments already checked).
+    fn new(points: &'a [Point3], k: usize) -> Result<Self> {
+        let quant = Quantizer::new(points).ok_or_else(|| Error::InvalidInput("empty".into()))?;
+        let sorted = morton_sorted(points, &quant);
+        let r = estimate_kth_distance(points, &sorted, k);
+        let level = level_for(&quant, r * CELL_RATIO);
+        let grid = CellGrid::new(points, quant, &sorted, level);
+        Ok(GridSearch {
+            points,
+            grid,
+            k,
+            fallback: OnceLock::new(),
+        })
+    }
+
+    /// The k nearest neighbours of sorted point `r`, left in `scratch.ids`, `scratch.d2` and
+    /// `scratch.pts`, nearest first, ties by input index.
+    fn query(&self, r: usize, scratch: &mut Scratch) {
+        let k = self.k;
+        scratch.ids.clear();
+        scratch.d2.clear();
+        scratch.pts.clear();
+        if grid_query(&self.grid, r, k, MAX_SHELLS, scratch) {
+            for &(d, id, pos) in &scratch.cands {
+                scratch.ids.push(id);
+                scratch.d2.push(f64::from_bits(d));
+                scratch.pts.push(self.grid.points[pos as usize]);
+            }
+            return;
+        }
+        // Outlier or very uneven density: exact k-d tree search (or an unbounded grid search
+        // if no tree can be built).
+        let tree = self
+            .fallback
+            .get_or_init(|| KdIndex::new(&self.grid.points));
+        match tree {
+            Some(tree) => {
+                let best = &mut scratch.best;
+                best.reset(k);
+                kd_query(tree, &self.grid.points, &self.grid.ids, r, best);
+                for (&d, &id) in best.d2.iter().zip(&best.id) {
+                    scratch.ids.push(id);
+                    scratch.d2.push(d);
+                    scratch.pts.push(self.points[id as usize]);
+                }
+                // The previous-query bound needs sorted positions: start afresh.
+                scratch.prev.clear();
+            }
+            None => {
+                grid_query(&self.grid, r, k, i64::MAX, scratch);
+                for &(d, id, pos) in &scratch.cands {
+                    scratch.ids.push(id);
+                    scratch.d2.push(f64::from_bits(d));
+                    scratch.pts.push(self.grid.points[pos as usize]);
+                }
+            }
+        }
+    }
 }
 
 /// Rows of width `k` in sorted order (`ids[r]` = input index of rank r) back to input order.
@@ -392,6 +510,12 @@ struct Scratch {
     cell: Option<[i64; 3]>,
     /// Non-empty cells of that block: (cell, first, end) sorted positions.
     near: Vec<([i64; 3], usize, usize)>,
+    /// Result of the last query: input indices, squared distances and coordinates.
+    ids: Vec<u32>,
+    d2: Vec<f64>,
+    pts: Vec<Point3>,
+    /// Candidates of the k-d tree fallback.
+    best: Best,
 }
 
 /// Appends the points of sorted range `lo..hi` within squared distance `t2_bits` of `q`
@@ -421,22 +545,16 @@ fn scan(
     cands.truncate(w);
 }
 
-/// Grid search for sorted point `r`, at most `max_shells` shells; writes the k nearest input
-/// indices to `row` and returns true, or false when unfinished.
+/// Grid search for sorted point `r`, at most `max_shells` shells; leaves the k nearest in
+/// `scratch.cands` (sorted by distance then input index) and returns true, or false when
+/// unfinished.
 ///
 /// The previous query p of the same thread bounds the search: among p and its k neighbours
 /// (k + 1 points) at least k differ from q, so the k-th smallest of their distances to q bounds
 /// q's k-th neighbour distance from above; farther candidates and cells are skipped from the
 /// start. Consecutive queries (Morton order) share most neighbours, so the bound is tight. Consecutive queries (Morton order)
 /// mostly share a cell, so the cell's 3 x 3 x 3 block is looked up once for all of them.
-fn grid_query(
-    grid: &CellGrid,
-    r: usize,
-    k: usize,
-    max_shells: i64,
-    scratch: &mut Scratch,
-    row: &mut [u32],
-) -> bool {
+fn grid_query(grid: &CellGrid, r: usize, k: usize, max_shells: i64, scratch: &mut Scratch) -> bool {
     let q = grid.points[r];
     let c = grid.cell_of(&q);
     let mut t2_bits = f64::INFINITY.to_bits();
@@ -487,9 +605,6 @@ fn grid_query(
             let b = grid.shell_bound(&q, c, s);
             if grid.covers_all(c, s) || (b > 0.0 && t2 < b * b) {
                 cands.sort_unstable();
-                for (o, c) in row.iter_mut().zip(cands.iter()) {
-                    *o = c.1;
-                }
                 scratch.prev.clear();
                 scratch.prev.push(r as u32);
                 scratch.prev.extend(cands.iter().map(|c| c.2));
