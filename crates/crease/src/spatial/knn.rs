@@ -603,13 +603,40 @@ fn grid_query(grid: &CellGrid, r: usize, k: usize, max_shells: i64, scratch: &mu
             t2_bits = kth;
             t2 = f64::from_bits(kth);
             let b = grid.shell_bound(&q, c, s);
-            if grid.covers_all(c, s) || (b > 0.0 && t2 < b * b) {
-                cands.sort_unstable();
-                scratch.prev.clear();
-                scratch.prev.push(r as u32);
-                scratch.prev.extend(cands.iter().map(|c| c.2));
-                return true;
+            if !(grid.covers_all(c, s) || (b > 0.0 && t2 < b * b)) {
+                // Some points within the k-th distance may lie beyond the scanned cube: scan
+                // the cells of the ball's bounding box outside it (usually a few face cells of
+                // the next shell), which makes the search exact.
+                let (lo, hi) = grid.cell_box(&q, t2.sqrt());
+                if (0..3).any(|a| c[a] - lo[a] > max_shells || hi[a] - c[a] > max_shells) {
+                    return false;
+                }
+                for z in lo[2]..=hi[2] {
+                    for y in lo[1]..=hi[1] {
+                        let inside_yz = (z - c[2]).abs() <= s && (y - c[1]).abs() <= s;
+                        for x in lo[0]..=hi[0] {
+                            if inside_yz && (x - c[0]).abs() <= s {
+                                continue;
+                            }
+                            let cell = [x, y, z];
+                            if grid.cell_min_dist2(&q, cell) > t2 {
+                                continue;
+                            }
+                            let range = grid.cell_range(cell);
+                            scan(grid, &q, r, range.start, range.end, t2_bits, cands);
+                        }
+                    }
+                }
+                if cands.len() > k {
+                    cands.select_nth_unstable(k - 1);
+                    cands.truncate(k);
+                }
             }
+            cands.sort_unstable();
+            scratch.prev.clear();
+            scratch.prev.push(r as u32);
+            scratch.prev.extend(cands.iter().map(|c| c.2));
+            return true;
         } else if grid.covers_all(c, s) {
             // Unreachable for n > k (every point was a candidate); keep the search sound anyway.
             return false;
