@@ -347,7 +347,7 @@ impl<'a> GridSearch<'a> {
         scratch.d2.clear();
         scratch.pts.clear();
         if grid_query(&self.grid, r, k, MAX_SHELLS, scratch) {
-            for &(d, id, pos) in &scratch.cands {
+            for &(d, id, pos) in &scratch.sel {
                 scratch.ids.push(id);
                 scratch.d2.push(f64::from_bits(d));
                 scratch.pts.push(self.grid.points[pos as usize]);
@@ -374,7 +374,7 @@ impl<'a> GridSearch<'a> {
             }
             None => {
                 grid_query(&self.grid, r, k, i64::MAX, scratch);
-                for &(d, id, pos) in &scratch.cands {
+                for &(d, id, pos) in &scratch.sel {
                     scratch.ids.push(id);
                     scratch.d2.push(f64::from_bits(d));
                     scratch.pts.push(self.grid.points[pos as usize]);
@@ -504,8 +504,10 @@ struct Scratch {
     cands: Vec<(u64, u32, u32)>,
     /// Sorted positions of the previous query of this thread and of its k neighbours.
     prev: Vec<u32>,
-    /// Squared distances from the current query to the points of `prev`.
-    seed: Vec<u64>,
+    /// Selection keys: truncated squared distance bits with the candidate's slot below.
+    keys: Vec<u64>,
+    /// The k selected candidates.
+    sel: Vec<(u64, u32, u32)>,
     /// The cell whose 3 x 3 x 3 block is in `near`.
     cell: Option<[i64; 3]>,
     /// Non-empty cells of that block: (cell, first, end) sorted positions.
@@ -546,7 +548,7 @@ fn scan(
 }
 
 /// Grid search for sorted point `r`, at most `max_shells` shells; leaves the k nearest in
-/// `scratch.cands` (sorted by distance then input index) and returns true, or false when
+/// `scratch.sel` (sorted by distance then input index) and returns true, or false when
 /// unfinished.
 ///
 /// The previous query p of the same thread bounds the search: among p and its k neighbours
@@ -558,19 +560,25 @@ fn grid_query(grid: &CellGrid, r: usize, k: usize, max_shells: i64, scratch: &mu
     let q = grid.points[r];
     let c = grid.cell_of(&q);
     let mut t2_bits = f64::INFINITY.to_bits();
-    if scratch.prev.len() > k {
-        scratch.seed.clear();
+    if scratch.prev.len() == k + 1 {
+        // The k-th smallest distance from q to the k + 1 points of `prev` other than q itself:
+        // their largest distance if q is one of them, else the second largest.
+        let (mut first, mut second) = (0u64, 0u64);
+        let mut has_q = false;
         for &j in &scratch.prev {
-            if j as usize != r {
-                scratch
-                    .seed
-                    .push(dist2(&q, &grid.points[j as usize]).to_bits());
+            if j as usize == r {
+                has_q = true;
+                continue;
+            }
+            let d = dist2(&q, &grid.points[j as usize]).to_bits();
+            if d > first {
+                second = first;
+                first = d;
+            } else if d > second {
+                second = d;
             }
         }
-        if scratch.seed.len() >= k {
-            let (_, kth, _) = scratch.seed.select_nth_unstable(k - 1);
-            t2_bits = *kth;
-        }
+        t2_bits = if has_q { first } else { second };
     }
     let mut t2 = f64::from_bits(t2_bits);
     if scratch.cell != Some(c) {
@@ -595,11 +603,8 @@ fn grid_query(grid: &CellGrid, r: usize, k: usize, max_shells: i64, scratch: &mu
     let mut s = 1i64;
     loop {
         if cands.len() >= k {
-            if cands.len() > k {
-                cands.select_nth_unstable(k - 1);
-                cands.truncate(k);
-            }
-            let kth = cands.iter().map(|c| c.0).max().unwrap_or(0);
+            select_sorted(cands, k, &mut scratch.keys, &mut scratch.sel);
+            let kth = scratch.sel.last().map_or(0, |c| c.0);
             t2_bits = kth;
             t2 = f64::from_bits(kth);
             let b = grid.shell_bound(&q, c, s);
@@ -627,15 +632,11 @@ fn grid_query(grid: &CellGrid, r: usize, k: usize, max_shells: i64, scratch: &mu
                         }
                     }
                 }
-                if cands.len() > k {
-                    cands.select_nth_unstable(k - 1);
-                    cands.truncate(k);
-                }
+                select_sorted(cands, k, &mut scratch.keys, &mut scratch.sel);
             }
-            cands.sort_unstable();
             scratch.prev.clear();
             scratch.prev.push(r as u32);
-            scratch.prev.extend(cands.iter().map(|c| c.2));
+            scratch.prev.extend(scratch.sel.iter().map(|c| c.2));
             return true;
         } else if grid.covers_all(c, s) {
             // Unreachable for n > k (every point was a candidate); keep the search sound anyway.
@@ -653,6 +654,79 @@ fn grid_query(grid: &CellGrid, r: usize, k: usize, max_shells: i64, scratch: &mu
             scan(grid, &q, r, range.start, range.end, t2_bits, cands);
         });
     }
+}
+
+/// Low bits of a selection key that hold the candidate's slot (the distance bits they replace
+/// are 2^-40 of its value: keys order candidates by distance except among near-equal ones, which
+/// [`select_sorted`] puts in exact order afterwards).
+const SLOT_BITS: u32 = 12;
+const SLOT_MASK: u64 = (1 << SLOT_BITS) - 1;
+/// Up to this many candidates are sorted whole rather than selected first.
+const FULL_SORT: usize = 64;
+
+/// The k candidates smallest by (squared distance, input index), sorted, into `sel`.
+///
+/// Candidates are ranked by u64 keys (distance bits with the slot in the low [`SLOT_BITS`]):
+/// quick selection and sorting of plain integers, then an insertion pass with the exact
+/// comparison, which only moves near-equal neighbours. When the k-th key's truncated distance is
+/// shared with candidates beyond it, those are ranked exactly too.
+fn select_sorted(
+    cands: &[(u64, u32, u32)],
+    k: usize,
+    keys: &mut Vec<u64>,
+    sel: &mut Vec<(u64, u32, u32)>,
+) {
+    sel.clear();
+    if cands.len() > SLOT_MASK as usize {
+        sel.extend_from_slice(cands);
+        sel.select_nth_unstable(k - 1);
+        sel.truncate(k);
+        sel.sort_unstable();
+        return;
+    }
+    keys.clear();
+    keys.extend(
+        cands
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (c.0 & !SLOT_MASK) | i as u64),
+    );
+    let mut m = keys.len();
+    if m > k && m > FULL_SORT {
+        keys.select_nth_unstable(k - 1);
+        let tk = keys[k - 1] & !SLOT_MASK;
+        // Candidates beyond the k-th whose truncated distance equals it may rank before it.
+        m = k;
+        for i in k..keys.len() {
+            if keys[i] & !SLOT_MASK == tk {
+                keys.swap(m, i);
+                m += 1;
+            }
+        }
+    }
+    let keys = &mut keys[..m];
+    keys.sort_unstable();
+    // Only candidates whose truncated distances are equal can be out of place: take the k
+    // first, plus those tied with the k-th, and order them exactly.
+    let mut end = m.min(k);
+    if let Some(&kth) = keys.get(end.wrapping_sub(1)) {
+        while end < m && keys[end] & !SLOT_MASK == kth & !SLOT_MASK {
+            end += 1;
+        }
+    }
+    sel.extend(
+        keys[..end]
+            .iter()
+            .map(|&key| cands[(key & SLOT_MASK) as usize]),
+    );
+    for i in 1..sel.len() {
+        let mut j = i;
+        while j > 0 && sel[j] < sel[j - 1] {
+            sel.swap(j, j - 1);
+            j -= 1;
+        }
+    }
+    sel.truncate(k);
 }
 
 /// Exact k-d tree search for point `r` of `pts` (input indices `ids`), ties by input index: asks
