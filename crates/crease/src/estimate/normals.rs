@@ -132,12 +132,11 @@ pub fn pca_normals(
     let (normals, eigenvalues): (Vec<Point3>, Vec<[f64; 3]>) = (0..n)
         .into_par_iter()
         .map_init(
-            || Vec::with_capacity(k + 1),
+            || Vec::with_capacity(k),
             |scratch: &mut Vec<Point3>, i| {
                 scratch.clear();
-                scratch.push(points[i]);
                 scratch.extend(nbrs.prefix(i, k).iter().map(|&j| points[j as usize]));
-                weighted_pca(scratch.as_mut_slice(), weight)
+                weighted_pca(points[i], scratch, weight)
             },
         )
         .unzip();
@@ -162,13 +161,8 @@ pub fn pca_normals_direct(points: &[Point3], params: &PcaParams) -> Result<PcaRe
     let fits: Vec<(Point3, [f64; 3])> = knn_map(
         points,
         k,
-        || Vec::with_capacity(k + 1),
-        |scratch: &mut Vec<Point3>, q| {
-            scratch.clear();
-            scratch.push(q.point);
-            scratch.extend_from_slice(q.neighbors);
-            weighted_pca(scratch.as_mut_slice(), weight)
-        },
+        || (),
+        |_, q| weighted_pca(q.point, q.neighbors, weight),
     )?;
     let (normals, eigenvalues) = fits.into_par_iter().unzip();
     Ok(PcaResult {
@@ -202,21 +196,25 @@ pub fn estimate_normals(points: &[Point3], k: usize) -> Result<Vec<Point3>> {
     .normals)
 }
 
-/// Equation 1 on one neighbourhood: (unit normal, eigenvalues ascending normalised by Σμ).
+/// Equation 1 on one neighbourhood, the point `p` and its neighbours `nbrs`: (unit normal,
+/// eigenvalues ascending normalised by Σμ).
+///
+/// Two passes: the centroid and the mean squared distance to it from sums taken relative to `p`
+/// (small numbers, no cancellation to speak of), then the weights and the covariance.
 #[inline]
-pub(crate) fn weighted_pca(pts: &mut [Point3], weight: PcaWeight) -> (Point3, [f64; 3]) {
-    let m = pts.len() as f64;
-    let mut c = [0.0; 3];
-    for p in pts.iter() {
-        c = vec3::add(c, *p);
+pub(crate) fn weighted_pca(p: Point3, nbrs: &[Point3], weight: PcaWeight) -> (Point3, [f64; 3]) {
+    let m = (nbrs.len() + 1) as f64;
+    let (mut sx, mut sy, mut sz, mut s2) = (0.0, 0.0, 0.0, 0.0);
+    for q in nbrs {
+        let (dx, dy, dz) = (q[0] - p[0], q[1] - p[1], q[2] - p[2]);
+        sx += dx;
+        sy += dy;
+        sz += dz;
+        s2 += dx * dx + dy * dy + dz * dz;
     }
-    let c = vec3::scale(c, 1.0 / m);
-    // Centre in place; the mean squared distance gives the relative sigma.
-    let mut sum_d2 = 0.0;
-    for p in pts.iter_mut() {
-        *p = vec3::sub(*p, c);
-        sum_d2 += vec3::dot(*p, *p);
-    }
+    // Centroid relative to p, and Σ|q − c|² = Σ|q − p|² − m |c − p|².
+    let c = [sx / m, sy / m, sz / m];
+    let sum_d2 = (s2 - m * vec3::dot(c, c)).max(0.0);
     let inv_s2 = match weight {
         PcaWeight::Uniform => 0.0,
         PcaWeight::GaussianFixed(s) => 1.0 / (s * s),
@@ -231,23 +229,29 @@ pub(crate) fn weighted_pca(pts: &mut [Point3], weight: PcaWeight) -> (Point3, [f
     };
     let mut a = [0.0f64; 6]; // xx xy xz yy yz zz
     let mut wsum = 0.0;
-    for d in pts.iter() {
+    let mut add = |d: Point3| {
         let w = if inv_s2 > 0.0 {
-            exp_neg(-vec3::dot(*d, *d) * inv_s2)
+            exp_neg(-(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) * inv_s2)
         } else {
             1.0
         };
         wsum += w;
-        a[0] += w * d[0] * d[0];
-        a[1] += w * d[0] * d[1];
-        a[2] += w * d[0] * d[2];
-        a[3] += w * d[1] * d[1];
-        a[4] += w * d[1] * d[2];
-        a[5] += w * d[2] * d[2];
+        let (wx, wy, wz) = (w * d[0], w * d[1], w * d[2]);
+        a[0] += wx * d[0];
+        a[1] += wx * d[1];
+        a[2] += wx * d[2];
+        a[3] += wy * d[1];
+        a[4] += wy * d[2];
+        a[5] += wz * d[2];
+    };
+    add([-c[0], -c[1], -c[2]]);
+    for q in nbrs {
+        add([q[0] - p[0] - c[0], q[1] - p[1] - c[1], q[2] - p[2] - c[2]]);
     }
     if wsum > 0.0 {
+        let inv = 1.0 / wsum;
         for v in &mut a {
-            *v /= wsum;
+            *v *= inv;
         }
     }
     smallest_eigen(a)

@@ -294,24 +294,51 @@ where
             },
         )
         .collect();
-    Ok(permute_to_input_order(in_rank_order, &grid.ids))
+    permute_to_input_order(in_rank_order, &grid.ids)
 }
 
-/// Moves `items[r]` to position `ids[r]` (`ids` is a permutation of `0..items.len()`), in place
-/// by following the permutation's cycles.
-fn permute_to_input_order<T>(mut items: Vec<T>, ids: &[u32]) -> Vec<T> {
-    let mut dest: Vec<u32> = ids.to_vec();
-    for i in 0..items.len() {
-        loop {
-            let d = dest[i] as usize;
-            if d == i || d >= items.len() {
-                break;
-            }
-            items.swap(i, d);
-            dest.swap(i, d);
+/// Moves `items[r]` to position `ids[r]` (`ids` is a permutation of `0..items.len()`).
+///
+/// A parallel scatter. `ids` always is a permutation (it comes from sorting `0..n`); this is
+/// verified first, so the unsafe scatter only ever runs on a checked permutation, and an error
+/// is returned otherwise.
+fn permute_to_input_order<T: Send>(items: Vec<T>, ids: &[u32]) -> Result<Vec<T>> {
+    let n = items.len();
+    let mut seen = vec![false; n];
+    let valid = ids.len() == n
+        && ids.iter().all(|&i| {
+            seen.get_mut(i as usize)
+                .is_some_and(|s| !std::mem::replace(s, true))
+        });
+    drop(seen);
+    if !valid {
+        return Err(Error::InvalidInput(
+            "internal error: the spatial order is not a permutation of the points".into(),
+        ));
+    }
+    /// A raw pointer that may cross threads: each thread writes distinct slots.
+    struct Dest<T>(*mut T);
+    // SAFETY: only used to write distinct slots of one allocation from several threads.
+    unsafe impl<T: Send> Send for Dest<T> {}
+    unsafe impl<T: Send> Sync for Dest<T> {}
+    impl<T> Dest<T> {
+        fn get(&self) -> *mut T {
+            self.0
         }
     }
+    let mut out: Vec<T> = Vec::with_capacity(n);
+    let dest = Dest(out.as_mut_ptr());
     items
+        .into_par_iter()
+        .zip(ids.par_iter())
+        .for_each(|(item, &i)| {
+            // SAFETY: `ids` is a permutation of 0..n (checked above), so every slot of the
+            // capacity-n buffer is written exactly once, by one thread; writing cannot panic.
+            unsafe { dest.get().add(i as usize).write(item) }
+        });
+    // SAFETY: all n slots were initialised above.
+    unsafe { out.set_len(n) };
+    Ok(out)
 }
 
 /// The grid search over one cloud: the Morton-sorted points bucketed in cells, and the k-d tree
@@ -750,5 +777,23 @@ fn kd_query(index: &KdIndex, pts: &[Point3], ids: &[u32], r: usize, best: &mut B
             return;
         }
         want = (want * 2).min(n);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn permutation_to_input_order() {
+        let ids: Vec<u32> = vec![3, 0, 4, 1, 2];
+        let items: Vec<String> = (0..5).map(|r| format!("rank {r}")).collect();
+        let out = permute_to_input_order(items.clone(), &ids).unwrap();
+        for (r, &i) in ids.iter().enumerate() {
+            assert_eq!(out[i as usize], items[r]);
+        }
+        // Not a permutation: an error, never a panic.
+        assert!(permute_to_input_order(items.clone(), &[1, 1, 7, 0, 2]).is_err());
+        assert!(permute_to_input_order(items.clone(), &[0, 1]).is_err());
     }
 }
