@@ -19,34 +19,37 @@
 //! such points exist. Ties are broken by input index everywhere, so the result equals brute force
 //! and does not depend on the thread count or the input order.
 //!
-//! # Measured (release, 1M points on a unit cube's faces jittered along the normal, k = 20)
-//! The 2-core machine was shared with other jobs (load average about 5.5) while measuring, so
-//! CPU time (user + system, summed over threads) is the comparable figure; wall times were 1.5
-//! to 3 times larger. Same cloud in its sampled (random) order and after a Morton sort
-//! (`tests/spatial_knn.rs`, `timing_1m_cube_faces`, ignored by default):
+//! [`knn_map`] runs the same search but hands each neighbourhood (indices, coordinates, squared
+//! distances) to a closure while it is in cache, and returns the closure's results in input
+//! order, with no n·k lists at all; [`knn`] is the same query loop writing rows.
 //!
-//! | method                                       | random order, CPU s | Morton-sorted, CPU s |
-//! |----------------------------------------------|---------------------|----------------------|
-//! | [`KnnMethod::KdTree`] (kiddo, input order)   | 21.5 (1 thr), 20.5 (2 thr) | 9.3 (1 and 2 thr) |
-//! | [`KnnMethod::KdTreeMorton`] (kiddo, sorted)  | 9.9                 | 9.9                  |
-//! | [`KnnMethod::Grid`] (default)                | 1.07                | 0.96                 |
+//! Per query: the previous query p of the same task bounds the k-th distance from above (the
+//! k-th smallest distance from q to p and its k neighbours, O(k): the largest or second largest
+//! of them), which prunes the 3 x 3 x 3 block of cells around q's cell; the candidates within
+//! the bound (≈ 2k on surfaces) are ranked on packed u64 keys (distance bits, slot in the low 12
+//! bits) and finished by an exact (distance, index) insertion pass; if the ball of the k-th
+//! distance leaves the block, only the cells of its bounding box outside the block are scanned.
 //!
-//! The grid is about 10 times faster than kiddo on sorted points and 20 times faster in random
-//! order, and nearly insensitive to the input order (the internal sort costs about 0.1 s). Of
-//! its 1.0 CPU s: Morton sort ≈ 0.1, grid build ≈ 0.03, queries ≈ 0.8, gathering the rows back
-//! to input order ≈ 0.05. On two idle cores that is about 0.5 s wall. Cell sides of 0.5x and 2x
-//! the estimated k-th neighbour distance measured 2.0 and 1.15 CPU s (1x: 1.0); a plain
-//! insertion into a sorted array of k instead of the seeded bound + selection: 1.7 CPU s.
-//! Memory: the points copied in Morton order (24 B/point), input indices and ranks (8 B/point),
-//! the cell table (≤ 32 B/point), and two n·k u32 buffers (rows in Morton order, rows in input
-//! order): about 230 MB for 1M points at k = 20; the whole 1M timing test (synthetic cloud with
-//! its attributes, a sorted copy, the result) peaks at 312 MB resident.
+//! # Measured (release, 1M points on a unit cube's faces, k = 20, shared 2-core machine)
+//! Load average 2 to 5 from other jobs while measuring, so CPU time (user + system) is the
+//! comparable figure (`tests/normals.rs`, `timing_1m`, ignored by default; best of 3):
 //!
-//! Criterion (`cargo bench -p crease --bench spatial`, same loaded machine, 2 threads, wall
-//! time, median): grid 14 ms / 13 ms at 10k (random / sorted), 187 / 202 ms at 100k, 1.61 /
-//! 1.08 s at 1M; kiddo per point 70 / 68 ms at 10k and 0.75 / 0.96 s at 100k; kiddo k-d tree
-//! build 0.53 ms / 8.6 ms / 286 ms and Morton order 0.46 / 6.2 / 113 ms at 10k / 100k / 1M;
-//! radius search (r = 2.5 x the spacing, about 20 neighbours) at 100k: 262 / 231 ms.
+//! | step                                              | 1 thread, CPU s | 2 threads, CPU s (wall) |
+//! |---------------------------------------------------|-----------------|-------------------------|
+//! | [`knn`] (CSR rows in input order)                 |                 | 0.80 to 0.84 (0.47)     |
+//! | `pca_normals_direct` ([`knn_map`] + PCA, fused)   | 1.14 to 1.22    | 1.12 to 1.18 (0.63)     |
+//!
+//! The fused path, random or Morton-sorted input alike, was 1.45 CPU s before this search's
+//! changes (O(k) seed instead of a selection: -5 %; one selection on packed u64 keys instead of
+//! selection + sort of tuples: -8 %; parallel scatter back to input order instead of a serial
+//! cycle walk: -55 ms wall). Tried and dropped: a per-thread cache of cell-table lookups (no
+//! gain), a 64-bucket distribution sort of the candidates (+10 %), selection before sorting
+//! when there are fewer than 64 candidates (+3 %). Earlier measurements: kiddo per point
+//! 21.5 CPU s random / 9.3 sorted; cell sides of 0.5x and 2x the estimated k-th neighbour
+//! distance 2.0 and 1.15 CPU s against 1.0 for 1x. Memory: the points in Morton order (24
+//! B/point), input indices (4 B/point), the cell table (≤ 32 B/point), plus for [`knn`] two n·k
+//! u32 buffers (160 MB at 1M, k = 20) and for [`knn_map`] only the n results; `crease normals`
+//! on 1M points (reading, fused PCA, writing) peaks at 156 MB resident.
 
 use std::sync::OnceLock;
 
