@@ -1,4 +1,5 @@
-//! Normal estimation benchmarks: weighted PCA (tran eq. 1) given the k = 20 neighbourhoods, at
+//! Normal estimation benchmarks: `pca_normals_direct` (fused kNN search + PCA, the whole
+//! estimate), then weighted PCA (tran eq. 1) given the k = 20 neighbourhoods, at
 //! 10k, 100k and 1M points on the faces of the synthetic cube in sampling (random) order and in
 //! spatially sorted order; the closed-form 3×3 eigen-solver against nalgebra's `SymmetricEigen`;
 //! Hoppe orientation. The kNN itself is benchmarked in the spatial benchmarks.
@@ -7,7 +8,7 @@
 
 use std::hint::black_box;
 
-use crease::estimate::normals::smallest_eigen;
+use crease::estimate::normals::{pca_normals_direct, smallest_eigen};
 use crease::estimate::{orient_normals, pca_normals, PcaParams, PcaWeight};
 use crease::geometry::Point3;
 use crease::spatial::knn;
@@ -57,6 +58,16 @@ fn bench_pca(c: &mut Criterion) {
         }
         let (random, sorted) = clouds(n);
         for (order, pts) in [("random", &random), ("sorted", &sorted)] {
+            // The fused path: kNN search and PCA in one pass over the Morton order.
+            g.bench_with_input(
+                BenchmarkId::new(format!("{order}/direct"), n),
+                &n,
+                |b, _| {
+                    b.iter(|| {
+                        black_box(pca_normals_direct(pts, &PcaParams::default()).expect("pca"))
+                    })
+                },
+            );
             let nbrs = knn(pts, 20).expect("knn");
             for (wname, w) in [
                 ("gauss", PcaParams::default().weight),

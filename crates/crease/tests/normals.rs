@@ -2,6 +2,7 @@
 //! and cylinder clouds with and without noise, mesh vertex normals on a sphere mesh, Hoppe
 //! orientation on closed shapes, determinism across thread counts, and argument errors.
 
+use crease::estimate::normals::pca_normals_direct;
 use crease::estimate::{
     estimate_normals, mesh_vertex_normals, orient_normals, pca_normals, PcaParams, PcaWeight,
     Weighting,
@@ -314,6 +315,54 @@ fn deterministic_across_thread_counts() {
     let (r2, o2) = run(2);
     assert_eq!(r1, r2);
     assert_eq!(o1, o2);
+    // The fused search + PCA gives exactly the same result, whatever the thread count.
+    for t in [1, 2, 3] {
+        let d = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+            .install(|| pca_normals_direct(pts, &PcaParams::default()).unwrap());
+        assert_eq!(d, r1, "{t} threads");
+    }
+}
+
+#[test]
+fn direct_equals_knn_then_pca() {
+    for (shape, noise) in [("cube", 0.2), ("fillet-chamfer-cone", 0.0), ("plane", 0.5)] {
+        let part = sample(shape, 8000, noise);
+        let pts = &part.cloud.positions;
+        let nbrs = knn(pts, 24).unwrap();
+        for k in [6, 20, 24] {
+            for weight in [
+                PcaParams::default().weight,
+                PcaWeight::Uniform,
+                PcaWeight::GaussianFixed(0.05),
+            ] {
+                let params = PcaParams { k, weight };
+                assert_eq!(
+                    pca_normals_direct(pts, &params).unwrap(),
+                    pca_normals(pts, &nbrs, &params).unwrap(),
+                    "{shape} k = {k} {weight:?}"
+                );
+            }
+        }
+    }
+    let part = sample("plane", 100, 0.0);
+    let pts = &part.cloud.positions;
+    let bad = PcaParams {
+        k: 20,
+        weight: PcaWeight::GaussianRelative(0.0),
+    };
+    assert!(pca_normals_direct(pts, &bad).is_err());
+    assert!(pca_normals_direct(
+        pts,
+        &PcaParams {
+            k: 0,
+            ..Default::default()
+        }
+    )
+    .is_err());
+    assert!(pca_normals_direct(&pts[..20], &PcaParams::default()).is_err());
 }
 
 #[test]
@@ -445,21 +494,47 @@ fn timing_1m() {
         .collect();
     keyed.sort_unstable();
     let sorted: Vec<Point3> = keyed.iter().map(|&(_, i)| random[i]).collect();
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    eprintln!("load average: {}", load.trim());
+    let reps: usize = std::env::var("CREASE_REPS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(3);
     for (name, pts) in [("random", &random), ("sorted", &sorted)] {
-        let t = Instant::now();
-        let nbrs = knn(pts, 20).unwrap();
-        let t_knn = t.elapsed().as_secs_f64();
-        for w in [PcaParams::default().weight, PcaWeight::Uniform] {
-            let (t, c) = (Instant::now(), cpu());
-            let r = pca_normals(pts, &nbrs, &PcaParams { k: 20, weight: w }).unwrap();
-            let t_pca = t.elapsed().as_secs_f64();
-            std::hint::black_box(&r);
-            eprintln!(
-                "{name} n={n}: knn {t_knn:.3} s, pca {w:?} {t_pca:.3} s wall, {:.2} s cpu",
-                cpu() - c
-            );
+        // Best of `reps` (wall, cpu) of a closure.
+        let best = |f: &dyn Fn()| {
+            let mut b = (f64::INFINITY, f64::INFINITY);
+            for _ in 0..reps {
+                let (t, c) = (Instant::now(), cpu());
+                f();
+                b.0 = b.0.min(t.elapsed().as_secs_f64());
+                b.1 = b.1.min(cpu() - c);
+            }
+            b
+        };
+        let params = PcaParams::default();
+        let direct = best(&|| {
+            std::hint::black_box(pca_normals_direct(pts, &params).unwrap());
+        });
+        eprintln!(
+            "{name} n={n}: pca_normals_direct (kNN + PCA fused) {:.3} s wall, {:.2} s cpu",
+            direct.0, direct.1
+        );
+        if std::env::var("CREASE_DIRECT_ONLY").is_ok() {
+            continue;
         }
-        let r = pca_normals(pts, &nbrs, &PcaParams::default()).unwrap();
+        let t_knn = best(&|| {
+            std::hint::black_box(knn(pts, 20).unwrap());
+        });
+        let nbrs = knn(pts, 20).unwrap();
+        let t_pca = best(&|| {
+            std::hint::black_box(pca_normals(pts, &nbrs, &params).unwrap());
+        });
+        eprintln!(
+            "{name} n={n}: knn {:.3} s wall / {:.2} s cpu, then pca_normals {:.3} s wall / {:.2} s cpu",
+            t_knn.0, t_knn.1, t_pca.0, t_pca.1
+        );
+        let r = pca_normals(pts, &nbrs, &params).unwrap();
         let (t, c) = (Instant::now(), cpu());
         let o = orient_normals(pts, &r.normals, &nbrs).unwrap();
         eprintln!(

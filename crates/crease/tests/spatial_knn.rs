@@ -2,6 +2,7 @@
 //! index), prefixes, input order, thread-count independence, argument errors.
 
 use crease::geometry::Point3;
+use crease::spatial::knn::{knn_map, KnnQuery};
 use crease::spatial::{knn, knn_with, knn_within, radius_neighbors, KnnMethod};
 use crease::synth::{sample_points, Noise, SampleParams, Shape};
 
@@ -90,7 +91,55 @@ fn shuffle(p: &[Point3], seed: u64) -> (Vec<Point3>, Vec<usize>) {
     (perm.iter().map(|&i| p[i]).collect(), perm)
 }
 
+/// Everything [`knn_map`] hands to its closure, owned.
+#[derive(Debug, Clone, PartialEq)]
+struct Seen {
+    index: usize,
+    point: Point3,
+    neighbors: Vec<Point3>,
+    ids: Vec<u32>,
+    dist2: Vec<f64>,
+    /// How many queries this task's scratch had seen before (must not leak into results).
+    calls: usize,
+}
+
+fn map_all(p: &[Point3], k: usize) -> Vec<Seen> {
+    knn_map(
+        p,
+        k,
+        || 0usize,
+        |calls: &mut usize, q: &KnnQuery| {
+            *calls += 1;
+            Seen {
+                index: q.index,
+                point: q.point,
+                neighbors: q.neighbors.to_vec(),
+                ids: q.ids.to_vec(),
+                dist2: q.dist2.to_vec(),
+                calls: 0,
+            }
+        },
+    )
+    .unwrap()
+}
+
+fn assert_knn_map_exact(p: &[Point3], k: usize, what: &str) {
+    let seen = map_all(p, k);
+    assert_eq!(seen.len(), p.len());
+    for (i, s) in seen.iter().enumerate() {
+        let expect = brute_knn(p, i, k);
+        assert_eq!(s.index, i, "{what}: k = {k}, point {i}");
+        assert_eq!(s.point, p[i]);
+        assert_eq!(s.ids, expect, "{what}: k = {k}, knn_map, point {i}");
+        let pts: Vec<Point3> = expect.iter().map(|&j| p[j as usize]).collect();
+        assert_eq!(s.neighbors, pts);
+        let d: Vec<f64> = pts.iter().map(|q| d2(&p[i], q)).collect();
+        assert_eq!(s.dist2, d);
+    }
+}
+
 fn assert_knn_exact(p: &[Point3], k: usize, what: &str) {
+    assert_knn_map_exact(p, k, what);
     for method in [KnnMethod::Grid, KnnMethod::KdTree, KnnMethod::KdTreeMorton] {
         let nb = knn_with(p, k, method).unwrap();
         assert_eq!(nb.len(), p.len());
@@ -219,6 +268,20 @@ fn thread_count_does_not_change_the_result() {
     };
     assert_eq!(run(1), run(2));
     assert_eq!(run(1), run(3));
+    let map = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| map_all(&p, 16))
+    };
+    let one = map(1);
+    assert_eq!(one, map(2));
+    assert_eq!(one, map(3));
+    let nb = knn(&p, 16).unwrap();
+    for (i, s) in one.iter().enumerate() {
+        assert_eq!(s.ids.as_slice(), nb.of(i));
+    }
 }
 
 #[test]
@@ -233,6 +296,12 @@ fn argument_errors() {
     assert!(knn(&bad, 3).is_err());
     bad[4][1] = f64::INFINITY;
     assert!(knn(&bad, 3).is_err());
+    let unit = |_: &mut (), _: &KnnQuery| ();
+    assert!(knn_map(&p, 0, || (), unit).is_err());
+    assert!(knn_map(&p, 10, || (), unit).is_err());
+    assert_eq!(knn_map(&p, 9, || (), unit).unwrap().len(), 10);
+    assert!(knn_map(&[], 1, || (), unit).is_err());
+    assert!(knn_map(&bad, 3, || (), unit).is_err());
 }
 
 /// Brute-force neighbours within r (d² ≤ r²), self excluded, sorted by distance then index.

@@ -87,8 +87,11 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
     let n = geom.points.len();
     let had_normals = geom.points.normals.is_some();
     let needs_knn = a.method != Method::Mesh || a.orient;
+    // PCA without --orient needs no stored neighbourhoods: the fused search visits them in
+    // spatial order (faster, no n·k lists); its time is reported under "normals".
+    let fused = a.method == Method::Pca && !a.orient;
     let mut t_knn = 0.0;
-    let nbrs = if needs_knn {
+    let nbrs = if needs_knn && !fused {
         let stage = Stage::start(&format!("{} nearest neighbours", a.k), g.quiet);
         let nbrs = crease::spatial::knn(&geom.points.positions, a.k)
             .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
@@ -99,6 +102,17 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
     };
     let stage = Stage::start(&format!("{} normals", a.method.name()), g.quiet);
     let mut normals = match a.method {
+        Method::Pca if fused => {
+            estimate::normals::pca_normals_direct(
+                &geom.points.positions,
+                &PcaParams {
+                    k: a.k,
+                    ..Default::default()
+                },
+            )
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?
+            .normals
+        }
         Method::Pca => {
             let nbrs = nbrs
                 .as_ref()

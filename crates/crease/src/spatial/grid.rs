@@ -177,6 +177,17 @@ impl CellGrid {
         d2
     }
 
+    /// The inclusive range of cells (lowest and highest corner cell) that meet the axis-aligned
+    /// box `q ± t`, widened by the rounding slack and clamped to the grid: every point within
+    /// distance `t` of `q` lies in one of them.
+    #[inline]
+    pub fn cell_box(&self, q: &Point3, t: f64) -> ([i64; 3], [i64; 3]) {
+        let t = t + self.margin;
+        let lo = self.cell_of(&[q[0] - t, q[1] - t, q[2] - t]);
+        let hi = self.cell_of(&[q[0] + t, q[1] + t, q[2] + t]);
+        (lo, hi)
+    }
+
     /// True when the cube of cells within Chebyshev distance `s` of `c` covers the whole grid.
     #[inline]
     pub fn covers_all(&self, c: [i64; 3], s: i64) -> bool {

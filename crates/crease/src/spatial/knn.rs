@@ -19,34 +19,39 @@
 //! such points exist. Ties are broken by input index everywhere, so the result equals brute force
 //! and does not depend on the thread count or the input order.
 //!
-//! # Measured (release, 1M points on a unit cube's faces jittered along the normal, k = 20)
-//! The 2-core machine was shared with other jobs (load average about 5.5) while measuring, so
-//! CPU time (user + system, summed over threads) is the comparable figure; wall times were 1.5
-//! to 3 times larger. Same cloud in its sampled (random) order and after a Morton sort
-//! (`tests/spatial_knn.rs`, `timing_1m_cube_faces`, ignored by default):
+//! [`knn_map`] runs the same search but hands each neighbourhood (indices, coordinates, squared
+//! distances) to a closure while it is in cache, and returns the closure's results in input
+//! order, with no n·k lists at all; [`knn`] is the same query loop writing rows.
 //!
-//! | method                                       | random order, CPU s | Morton-sorted, CPU s |
-//! |----------------------------------------------|---------------------|----------------------|
-//! | [`KnnMethod::KdTree`] (kiddo, input order)   | 21.5 (1 thr), 20.5 (2 thr) | 9.3 (1 and 2 thr) |
-//! | [`KnnMethod::KdTreeMorton`] (kiddo, sorted)  | 9.9                 | 9.9                  |
-//! | [`KnnMethod::Grid`] (default)                | 1.07                | 0.96                 |
+//! Per query: the previous query p of the same task bounds the k-th distance from above (the
+//! k-th smallest distance from q to p and its k neighbours, O(k): the largest or second largest
+//! of them), which prunes the 3 x 3 x 3 block of cells around q's cell; the candidates within
+//! the bound (≈ 2k on surfaces) are ranked on packed u64 keys (distance bits, slot in the low 12
+//! bits) and finished by an exact (distance, index) insertion pass; if the ball of the k-th
+//! distance leaves the block, only the cells of its bounding box outside the block are scanned.
 //!
-//! The grid is about 10 times faster than kiddo on sorted points and 20 times faster in random
-//! order, and nearly insensitive to the input order (the internal sort costs about 0.1 s). Of
-//! its 1.0 CPU s: Morton sort ≈ 0.1, grid build ≈ 0.03, queries ≈ 0.8, gathering the rows back
-//! to input order ≈ 0.05. On two idle cores that is about 0.5 s wall. Cell sides of 0.5x and 2x
-//! the estimated k-th neighbour distance measured 2.0 and 1.15 CPU s (1x: 1.0); a plain
-//! insertion into a sorted array of k instead of the seeded bound + selection: 1.7 CPU s.
-//! Memory: the points copied in Morton order (24 B/point), input indices and ranks (8 B/point),
-//! the cell table (≤ 32 B/point), and two n·k u32 buffers (rows in Morton order, rows in input
-//! order): about 230 MB for 1M points at k = 20; the whole 1M timing test (synthetic cloud with
-//! its attributes, a sorted copy, the result) peaks at 312 MB resident.
+//! # Measured (release, 1M points on a unit cube's faces, k = 20, shared 2-core machine)
+//! Load average 2 to 5 from other jobs while measuring, so CPU time (user + system) is the
+//! comparable figure (`tests/normals.rs`, `timing_1m`, ignored by default; best of 3):
 //!
-//! Criterion (`cargo bench -p crease --bench spatial`, same loaded machine, 2 threads, wall
-//! time, median): grid 14 ms / 13 ms at 10k (random / sorted), 187 / 202 ms at 100k, 1.61 /
-//! 1.08 s at 1M; kiddo per point 70 / 68 ms at 10k and 0.75 / 0.96 s at 100k; kiddo k-d tree
-//! build 0.53 ms / 8.6 ms / 286 ms and Morton order 0.46 / 6.2 / 113 ms at 10k / 100k / 1M;
-//! radius search (r = 2.5 x the spacing, about 20 neighbours) at 100k: 262 / 231 ms.
+//! | step                                              | 1 thread, CPU s | 2 threads, CPU s (wall) |
+//! |---------------------------------------------------|-----------------|-------------------------|
+//! | [`knn`] (CSR rows in input order)                 |                 | 0.80 to 0.84 (0.47)     |
+//! | `pca_normals_direct` ([`knn_map`] + PCA, fused)   | 1.14 to 1.22    | 1.12 to 1.18 (0.63)     |
+//!
+//! The fused path, random or Morton-sorted input alike, was 1.45 CPU s before this search's
+//! changes (O(k) seed instead of a selection: -5 %; one selection on packed u64 keys instead of
+//! selection + sort of tuples: -8 %; parallel scatter back to input order instead of a serial
+//! cycle walk: -55 ms wall). Tried and dropped: a per-thread cache of cell-table lookups (no
+//! gain), a 64-bucket distribution sort of the candidates (+10 %), selection before sorting
+//! when there are fewer than 64 candidates (+3 %). Earlier measurements: kiddo per point
+//! 21.5 CPU s random / 9.3 sorted; cell sides of 0.5x and 2x the estimated k-th neighbour
+//! distance 2.0 and 1.15 CPU s against 1.0 for 1x. Memory: the points in Morton order (24
+//! B/point), input indices (4 B/point), the cell table (≤ 32 B/point), plus for [`knn`] two n·k
+//! u32 buffers (160 MB at 1M, k = 20) and for [`knn_map`] only the n results; `crease normals`
+//! on 1M points (reading, fused PCA, writing) peaks at 156 MB resident.
+
+use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
@@ -211,59 +216,202 @@ pub fn knn_with(points: &[Point3], k: usize, method: KnnMethod) -> Result<Neighb
             gather_fixed(&buf, &ids, k)
         }
         KnnMethod::Grid => {
-            let quant =
-                Quantizer::new(points).ok_or_else(|| Error::InvalidInput("empty".into()))?;
-            let sorted = morton_sorted(points, &quant);
-            let r = estimate_kth_distance(points, &sorted, k);
-            let level = level_for(&quant, r * CELL_RATIO);
-            let grid = CellGrid::new(points, quant, &sorted, level);
-            drop(sorted);
+            let search = GridSearch::new(points, k)?;
             let mut buf = vec![0u32; n * k];
-            let done: Vec<bool> = buf
-                .par_chunks_mut(k)
-                .enumerate()
-                .map_init(Scratch::default, |scratch, (r, row)| {
-                    grid_query(&grid, r, k, MAX_SHELLS, scratch, row)
-                })
-                .collect();
-            let failed: Vec<usize> = done
-                .par_iter()
-                .enumerate()
-                .filter_map(|(r, ok)| (!ok).then_some(r))
-                .collect();
-            if !failed.is_empty() {
-                let index = KdIndex::new(&grid.points);
-                let rows: Vec<Vec<u32>> = failed
-                    .par_iter()
-                    .map_init(
-                        || (Best::default(), Scratch::default()),
-                        |(best, scratch), &r| {
-                            let mut row = vec![0u32; k];
-                            match &index {
-                                Some(index) => {
-                                    best.reset(k);
-                                    kd_query(index, &grid.points, &grid.ids, r, best);
-                                    row.copy_from_slice(&best.id);
-                                }
-                                None => {
-                                    grid_query(&grid, r, k, i64::MAX, scratch, &mut row);
-                                }
-                            }
-                            row
-                        },
-                    )
-                    .collect();
-                for (&r, row) in failed.iter().zip(rows) {
-                    buf[r * k..(r + 1) * k].copy_from_slice(&row);
-                }
-            }
-            gather_fixed(&buf, &grid.ids, k)
+            buf.par_chunks_mut(k * TASK).enumerate().for_each_init(
+                Scratch::default,
+                |scratch, (t, rows)| {
+                    for (j, row) in rows.chunks_exact_mut(k).enumerate() {
+                        search.query(t * TASK + j, scratch);
+                        row.copy_from_slice(&scratch.ids);
+                    }
+                },
+            );
+            gather_fixed(&buf, &search.grid.ids, k)
         }
     };
     Ok(Neighborhoods::from_csr(
         k,
         Csr::from_fixed_width(n, k, indices),
     ))
+}
+
+/// Queries per parallel task: consecutive queries in Morton order share cells and most of their
+/// neighbours, so each task walks a long run of them with one scratch.
+const TASK: usize = 1024;
+
+/// One query's neighbourhood, handed to the closure of [`knn_map`].
+///
+/// The slices are the query's k nearest other points, nearest first, ties by input index:
+/// exactly the row [`knn`] returns for `index`, with the coordinates and squared distances
+/// alongside.
+#[derive(Debug, Clone, Copy)]
+pub struct KnnQuery<'a> {
+    /// Input index of the query point.
+    pub index: usize,
+    /// The query point.
+    pub point: Point3,
+    /// Coordinates of its k nearest neighbours, nearest first (the point itself excluded).
+    pub neighbors: &'a [Point3],
+    /// Input indices of the neighbours, same order.
+    pub ids: &'a [u32],
+    /// Squared distances from the query to the neighbours, same order (non-decreasing).
+    pub dist2: &'a [f64],
+}
+
+/// Calls `f` on the k-nearest-neighbour neighbourhood of every point and returns its results in
+/// input order, without storing the n·k neighbour lists.
+///
+/// The queries run in parallel in Morton order (see the module doc), so each neighbourhood is
+/// handed to `f` while its points are in cache; `init` makes one scratch value per parallel task
+/// (reused across that task's queries, e.g. buffers for a local fit). The neighbourhoods are the
+/// rows of [`knn`] (exact, nearest first, ties by input index), and the result does not depend on
+/// the thread count as long as `f`'s result depends only on its [`KnnQuery`] (not on the
+/// scratch's history).
+///
+/// Errors as [`knn`]: k = 0, fewer than k + 1 points, a non-finite coordinate.
+pub fn knn_map<T, S, I, F>(points: &[Point3], k: usize, init: I, f: F) -> Result<Vec<T>>
+where
+    T: Send,
+    I: Fn() -> S + Sync + Send,
+    F: Fn(&mut S, &KnnQuery) -> T + Sync + Send,
+{
+    check_knn_args(points, k)?;
+    let search = GridSearch::new(points, k)?;
+    let grid = &search.grid;
+    let in_rank_order: Vec<T> = (0..points.len())
+        .into_par_iter()
+        .with_min_len(TASK)
+        .map_init(
+            || (Scratch::default(), init()),
+            |(scratch, state), r| {
+                search.query(r, scratch);
+                let query = KnnQuery {
+                    index: grid.ids[r] as usize,
+                    point: grid.points[r],
+                    neighbors: &scratch.pts,
+                    ids: &scratch.ids,
+                    dist2: &scratch.d2,
+                };
+                f(state, &query)
+            },
+        )
+        .collect();
+    permute_to_input_order(in_rank_order, &grid.ids)
+}
+
+/// Moves `items[r]` to position `ids[r]` (`ids` is a permutation of `0..items.len()`).
+///
+/// A parallel scatter. `ids` always is a permutation (it comes from sorting `0..n`); this is
+/// verified first, so the unsafe scatter only ever runs on a checked permutation, and an error
+/// is returned otherwise.
+fn permute_to_input_order<T: Send>(items: Vec<T>, ids: &[u32]) -> Result<Vec<T>> {
+    let n = items.len();
+    let mut seen = vec![false; n];
+    let valid = ids.len() == n
+        && ids.iter().all(|&i| {
+            seen.get_mut(i as usize)
+                .is_some_and(|s| !std::mem::replace(s, true))
+        });
+    drop(seen);
+    if !valid {
+        return Err(Error::InvalidInput(
+            "internal error: the spatial order is not a permutation of the points".into(),
+        ));
+    }
+    /// A raw pointer that may cross threads: each thread writes distinct slots.
+    struct Dest<T>(*mut T);
+    // SAFETY: only used to write distinct slots of one allocation from several threads.
+    unsafe impl<T: Send> Send for Dest<T> {}
+    unsafe impl<T: Send> Sync for Dest<T> {}
+    impl<T> Dest<T> {
+        fn get(&self) -> *mut T {
+            self.0
+        }
+    }
+    let mut out: Vec<T> = Vec::with_capacity(n);
+    let dest = Dest(out.as_mut_ptr());
+    items
+        .into_par_iter()
+        .zip(ids.par_iter())
+        .for_each(|(item, &i)| {
+            // SAFETY: `ids` is a permutation of 0..n (checked above), so every slot of the
+            // capacity-n buffer is written exactly once, by one thread; writing cannot panic.
+            unsafe { dest.get().add(i as usize).write(item) }
+        });
+    // SAFETY: all n slots were initialised above.
+    unsafe { out.set_len(n) };
+    Ok(out)
+}
+
+/// The grid search over one cloud: the Morton-sorted points bucketed in cells, and the k-d tree
+/// fallback for queries the grid cannot finish in a few shells, built on first use.
+struct GridSearch<'a> {
+    points: &'a [Point3],
+    grid: CellGrid,
+    k: usize,
+    fallback: OnceLock<Option<KdIndex>>,
+}
+
+impl<'a> GridSearch<'a> {
+    /// Sorts and buckets `points` (arguments already checked).
+    fn new(points: &'a [Point3], k: usize) -> Result<Self> {
+        let quant = Quantizer::new(points).ok_or_else(|| Error::InvalidInput("empty".into()))?;
+        let sorted = morton_sorted(points, &quant);
+        let r = estimate_kth_distance(points, &sorted, k);
+        let level = level_for(&quant, r * CELL_RATIO);
+        let grid = CellGrid::new(points, quant, &sorted, level);
+        Ok(GridSearch {
+            points,
+            grid,
+            k,
+            fallback: OnceLock::new(),
+        })
+    }
+
+    /// The k nearest neighbours of sorted point `r`, left in `scratch.ids`, `scratch.d2` and
+    /// `scratch.pts`, nearest first, ties by input index.
+    fn query(&self, r: usize, scratch: &mut Scratch) {
+        let k = self.k;
+        scratch.ids.clear();
+        scratch.d2.clear();
+        scratch.pts.clear();
+        if grid_query(&self.grid, r, k, MAX_SHELLS, scratch) {
+            for &(d, id, pos) in &scratch.sel {
+                scratch.ids.push(id);
+                scratch.d2.push(f64::from_bits(d));
+                scratch.pts.push(self.grid.points[pos as usize]);
+            }
+            return;
+        }
+        // Outlier or very uneven density: exact k-d tree search (or an unbounded grid search
+        // if no tree can be built).
+        let tree = self
+            .fallback
+            .get_or_init(|| KdIndex::new(&self.grid.points));
+        match tree {
+            Some(tree) => {
+                let best = &mut scratch.best;
+                best.reset(k);
+                kd_query(tree, &self.grid.points, &self.grid.ids, r, best);
+                for (&d, &id) in best.d2.iter().zip(&best.id) {
+                    scratch.ids.push(id);
+                    scratch.d2.push(d);
+                    scratch.pts.push(self.points[id as usize]);
+                }
+                // The previous-query bound needs sorted positions: start afresh.
+                scratch.prev.clear();
+            }
+            None => {
+                grid_query(&self.grid, r, k, i64::MAX, scratch);
+                for &(d, id, pos) in &scratch.sel {
+                    scratch.ids.push(id);
+                    scratch.d2.push(f64::from_bits(d));
+                    scratch.pts.push(self.grid.points[pos as usize]);
+                }
+            }
+        }
+    }
 }
 
 /// Rows of width `k` in sorted order (`ids[r]` = input index of rank r) back to input order.
@@ -386,12 +534,20 @@ struct Scratch {
     cands: Vec<(u64, u32, u32)>,
     /// Sorted positions of the previous query of this thread and of its k neighbours.
     prev: Vec<u32>,
-    /// Squared distances from the current query to the points of `prev`.
-    seed: Vec<u64>,
+    /// Selection keys: truncated squared distance bits with the candidate's slot below.
+    keys: Vec<u64>,
+    /// The k selected candidates.
+    sel: Vec<(u64, u32, u32)>,
     /// The cell whose 3 x 3 x 3 block is in `near`.
     cell: Option<[i64; 3]>,
     /// Non-empty cells of that block: (cell, first, end) sorted positions.
     near: Vec<([i64; 3], usize, usize)>,
+    /// Result of the last query: input indices, squared distances and coordinates.
+    ids: Vec<u32>,
+    d2: Vec<f64>,
+    pts: Vec<Point3>,
+    /// Candidates of the k-d tree fallback.
+    best: Best,
 }
 
 /// Appends the points of sorted range `lo..hi` within squared distance `t2_bits` of `q`
@@ -421,38 +577,38 @@ fn scan(
     cands.truncate(w);
 }
 
-/// Grid search for sorted point `r`, at most `max_shells` shells; writes the k nearest input
-/// indices to `row` and returns true, or false when unfinished.
+/// Grid search for sorted point `r`, at most `max_shells` shells; leaves the k nearest in
+/// `scratch.sel` (sorted by distance then input index) and returns true, or false when
+/// unfinished.
 ///
 /// The previous query p of the same thread bounds the search: among p and its k neighbours
 /// (k + 1 points) at least k differ from q, so the k-th smallest of their distances to q bounds
 /// q's k-th neighbour distance from above; farther candidates and cells are skipped from the
 /// start. Consecutive queries (Morton order) share most neighbours, so the bound is tight. Consecutive queries (Morton order)
 /// mostly share a cell, so the cell's 3 x 3 x 3 block is looked up once for all of them.
-fn grid_query(
-    grid: &CellGrid,
-    r: usize,
-    k: usize,
-    max_shells: i64,
-    scratch: &mut Scratch,
-    row: &mut [u32],
-) -> bool {
+fn grid_query(grid: &CellGrid, r: usize, k: usize, max_shells: i64, scratch: &mut Scratch) -> bool {
     let q = grid.points[r];
     let c = grid.cell_of(&q);
     let mut t2_bits = f64::INFINITY.to_bits();
-    if scratch.prev.len() > k {
-        scratch.seed.clear();
+    if scratch.prev.len() == k + 1 {
+        // The k-th smallest distance from q to the k + 1 points of `prev` other than q itself:
+        // their largest distance if q is one of them, else the second largest.
+        let (mut first, mut second) = (0u64, 0u64);
+        let mut has_q = false;
         for &j in &scratch.prev {
-            if j as usize != r {
-                scratch
-                    .seed
-                    .push(dist2(&q, &grid.points[j as usize]).to_bits());
+            if j as usize == r {
+                has_q = true;
+                continue;
+            }
+            let d = dist2(&q, &grid.points[j as usize]).to_bits();
+            if d > first {
+                second = first;
+                first = d;
+            } else if d > second {
+                second = d;
             }
         }
-        if scratch.seed.len() >= k {
-            let (_, kth, _) = scratch.seed.select_nth_unstable(k - 1);
-            t2_bits = *kth;
-        }
+        t2_bits = if has_q { first } else { second };
     }
     let mut t2 = f64::from_bits(t2_bits);
     if scratch.cell != Some(c) {
@@ -477,24 +633,41 @@ fn grid_query(
     let mut s = 1i64;
     loop {
         if cands.len() >= k {
-            if cands.len() > k {
-                cands.select_nth_unstable(k - 1);
-                cands.truncate(k);
-            }
-            let kth = cands.iter().map(|c| c.0).max().unwrap_or(0);
+            select_sorted(cands, k, &mut scratch.keys, &mut scratch.sel);
+            let kth = scratch.sel.last().map_or(0, |c| c.0);
             t2_bits = kth;
             t2 = f64::from_bits(kth);
             let b = grid.shell_bound(&q, c, s);
-            if grid.covers_all(c, s) || (b > 0.0 && t2 < b * b) {
-                cands.sort_unstable();
-                for (o, c) in row.iter_mut().zip(cands.iter()) {
-                    *o = c.1;
+            if !(grid.covers_all(c, s) || (b > 0.0 && t2 < b * b)) {
+                // Some points within the k-th distance may lie beyond the scanned cube: scan
+                // the cells of the ball's bounding box outside it (usually a few face cells of
+                // the next shell), which makes the search exact.
+                let (lo, hi) = grid.cell_box(&q, t2.sqrt());
+                if (0..3).any(|a| c[a] - lo[a] > max_shells || hi[a] - c[a] > max_shells) {
+                    return false;
                 }
-                scratch.prev.clear();
-                scratch.prev.push(r as u32);
-                scratch.prev.extend(cands.iter().map(|c| c.2));
-                return true;
+                for z in lo[2]..=hi[2] {
+                    for y in lo[1]..=hi[1] {
+                        let inside_yz = (z - c[2]).abs() <= s && (y - c[1]).abs() <= s;
+                        for x in lo[0]..=hi[0] {
+                            if inside_yz && (x - c[0]).abs() <= s {
+                                continue;
+                            }
+                            let cell = [x, y, z];
+                            if grid.cell_min_dist2(&q, cell) > t2 {
+                                continue;
+                            }
+                            let range = grid.cell_range(cell);
+                            scan(grid, &q, r, range.start, range.end, t2_bits, cands);
+                        }
+                    }
+                }
+                select_sorted(cands, k, &mut scratch.keys, &mut scratch.sel);
             }
+            scratch.prev.clear();
+            scratch.prev.push(r as u32);
+            scratch.prev.extend(scratch.sel.iter().map(|c| c.2));
+            return true;
         } else if grid.covers_all(c, s) {
             // Unreachable for n > k (every point was a candidate); keep the search sound anyway.
             return false;
@@ -511,6 +684,79 @@ fn grid_query(
             scan(grid, &q, r, range.start, range.end, t2_bits, cands);
         });
     }
+}
+
+/// Low bits of a selection key that hold the candidate's slot (the distance bits they replace
+/// are 2^-40 of its value: keys order candidates by distance except among near-equal ones, which
+/// [`select_sorted`] puts in exact order afterwards).
+const SLOT_BITS: u32 = 12;
+const SLOT_MASK: u64 = (1 << SLOT_BITS) - 1;
+/// Up to this many candidates are sorted whole rather than selected first.
+const FULL_SORT: usize = 64;
+
+/// The k candidates smallest by (squared distance, input index), sorted, into `sel`.
+///
+/// Candidates are ranked by u64 keys (distance bits with the slot in the low [`SLOT_BITS`]):
+/// quick selection and sorting of plain integers, then an insertion pass with the exact
+/// comparison, which only moves near-equal neighbours. When the k-th key's truncated distance is
+/// shared with candidates beyond it, those are ranked exactly too.
+fn select_sorted(
+    cands: &[(u64, u32, u32)],
+    k: usize,
+    keys: &mut Vec<u64>,
+    sel: &mut Vec<(u64, u32, u32)>,
+) {
+    sel.clear();
+    if cands.len() > SLOT_MASK as usize {
+        sel.extend_from_slice(cands);
+        sel.select_nth_unstable(k - 1);
+        sel.truncate(k);
+        sel.sort_unstable();
+        return;
+    }
+    keys.clear();
+    keys.extend(
+        cands
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (c.0 & !SLOT_MASK) | i as u64),
+    );
+    let mut m = keys.len();
+    if m > k && m > FULL_SORT {
+        keys.select_nth_unstable(k - 1);
+        let tk = keys[k - 1] & !SLOT_MASK;
+        // Candidates beyond the k-th whose truncated distance equals it may rank before it.
+        m = k;
+        for i in k..keys.len() {
+            if keys[i] & !SLOT_MASK == tk {
+                keys.swap(m, i);
+                m += 1;
+            }
+        }
+    }
+    let keys = &mut keys[..m];
+    keys.sort_unstable();
+    // Only candidates whose truncated distances are equal can be out of place: take the k
+    // first, plus those tied with the k-th, and order them exactly.
+    let mut end = m.min(k);
+    if let Some(&kth) = keys.get(end.wrapping_sub(1)) {
+        while end < m && keys[end] & !SLOT_MASK == kth & !SLOT_MASK {
+            end += 1;
+        }
+    }
+    sel.extend(
+        keys[..end]
+            .iter()
+            .map(|&key| cands[(key & SLOT_MASK) as usize]),
+    );
+    for i in 1..sel.len() {
+        let mut j = i;
+        while j > 0 && sel[j] < sel[j - 1] {
+            sel.swap(j, j - 1);
+            j -= 1;
+        }
+    }
+    sel.truncate(k);
 }
 
 /// Exact k-d tree search for point `r` of `pts` (input indices `ids`), ties by input index: asks
@@ -534,5 +780,23 @@ fn kd_query(index: &KdIndex, pts: &[Point3], ids: &[u32], r: usize, best: &mut B
             return;
         }
         want = (want * 2).min(n);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn permutation_to_input_order() {
+        let ids: Vec<u32> = vec![3, 0, 4, 1, 2];
+        let items: Vec<String> = (0..5).map(|r| format!("rank {r}")).collect();
+        let out = permute_to_input_order(items.clone(), &ids).unwrap();
+        for (r, &i) in ids.iter().enumerate() {
+            assert_eq!(out[i as usize], items[r]);
+        }
+        // Not a permutation: an error, never a panic.
+        assert!(permute_to_input_order(items.clone(), &[1, 1, 7, 0, 2]).is_err());
+        assert!(permute_to_input_order(items.clone(), &[0, 1]).is_err());
     }
 }
