@@ -8,7 +8,8 @@ pub mod plane;
 pub mod ring_normal;
 
 pub use normals::{
-    estimate_normals, mesh_vertex_normals, pca_normals, PcaParams, PcaResult, PcaWeight, Weighting,
+    estimate_normals, mesh_vertex_normals, pca_normals, pca_normals_direct, PcaParams, PcaResult,
+    PcaWeight, Weighting,
 };
 pub use orient::orient_normals;
 pub use plane::{fit_plane, Plane};

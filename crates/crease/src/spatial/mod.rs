@@ -9,7 +9,7 @@ pub mod radius;
 pub mod ring;
 
 pub use kdtree::KdIndex;
-pub use knn::{knn, knn_with, KnnMethod, Neighborhoods};
+pub use knn::{knn, knn_map, knn_with, KnnMethod, KnnQuery, Neighborhoods};
 pub use morton::morton_order;
 pub use radius::{knn_within, radius_neighbors};
 pub use ring::{delaunay_rings, RingParams, Rings};
