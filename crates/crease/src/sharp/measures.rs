@@ -93,12 +93,11 @@ pub(crate) fn local_pca_coords(
     weight: PcaWeight,
     work: &mut Vec<Point3>,
 ) -> LocalPca {
-    work.clear();
-    work.extend_from_slice(coords);
-    let (mut normal, mut eigenvalues) = weighted_pca(work.as_mut_slice(), weight);
-    if let Some(tau) = own_sheet(work, normal) {
+    let p = coords[0];
+    let (mut normal, mut eigenvalues) = weighted_pca(p, &coords[1..], weight);
+    let mut filtered = false;
+    if let Some(tau) = own_sheet(coords, normal) {
         // Keep the neighbours within tau of the point's offset along the normal.
-        let p = coords[0];
         work.clear();
         work.push(p);
         work.extend(
@@ -106,12 +105,21 @@ pub(crate) fn local_pca_coords(
                 .iter()
                 .filter(|q| vec3::dot(vec3::sub(**q, p), normal).abs() <= tau),
         );
-        (normal, eigenvalues) = weighted_pca(work.as_mut_slice(), weight);
+        (normal, eigenvalues) = weighted_pca(p, &work[1..], weight);
+        filtered = true;
     }
-    let m = work.len() as f64;
-    // weighted_pca centres the points in place on their plain centroid; the point came first.
-    let offset = work[0];
-    let rms_radius = (work.iter().map(|d| vec3::dot(*d, *d)).sum::<f64>() / m).sqrt();
+    let used: &[Point3] = if filtered { work } else { coords };
+    // Plain centroid and RMS radius, from sums relative to p.
+    let m = used.len() as f64;
+    let (mut s1, mut s2) = ([0.0f64; 3], 0.0f64);
+    for q in used {
+        let d = vec3::sub(*q, p);
+        s1 = vec3::add(s1, d);
+        s2 += vec3::dot(d, d);
+    }
+    let c = vec3::scale(s1, 1.0 / m);
+    let offset = vec3::scale(c, -1.0);
+    let rms_radius = (s2 / m - vec3::dot(c, c)).max(0.0).sqrt();
     LocalPca {
         normal,
         eigenvalues,
@@ -231,7 +239,8 @@ fn pca_value(
 /// the neighbourhood) and returns tau: the neighbours whose offset |(q − p)·n| along the normal is at most tau lie on
 /// the point's own sheet.
 ///
-/// `centred[0]` is the point, `centred[1..]` its neighbours, all relative to their centroid;
+/// `centred[0]` is the point and `centred[1..]` its neighbours (any common origin: only
+/// differences are used);
 /// `normal` is their PCA normal. The offsets h_j = (p_j − p)·n split at half their largest
 /// magnitude; the far group is another sheet when it lies on one side, is flat and parallel
 /// (its offsets span less than half their mean), and the near group is flat too (offsets below a
