@@ -1,13 +1,11 @@
 //! End-to-end tests of the `crease` binary: real data loads, bad input gives clear errors and
 //! the right exit codes, outputs never overwrite inputs, and the commands' outputs are correct.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
-
-fn crease() -> Command {
-    Command::cargo_bin("crease").expect("the crease binary is built")
-}
+use common::{crease, json_of};
 
 fn data_dir() -> Option<PathBuf> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
@@ -36,10 +34,6 @@ fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
             out.push(p);
         }
     }
-}
-
-fn json_of(out: &[u8]) -> serde_json::Value {
-    serde_json::from_slice(out).expect("--json prints valid JSON on stdout")
 }
 
 #[test]

@@ -1,26 +1,10 @@
 //! End-to-end tests of `crease curvature`: PLY properties in input order, analytic values on a
 //! synthetic sphere, the Bézier method's sharp flags on a cube mesh, and clear usage errors.
 
-use std::path::Path;
+mod common;
 
-use assert_cmd::Command;
+use common::{crease, synth};
 use crease::io::ReadOptions;
-
-fn crease() -> Command {
-    Command::cargo_bin("crease").expect("the crease binary is built")
-}
-
-fn synth(dir: &Path, args: &[&str], name: &str) -> std::path::PathBuf {
-    let out = dir.join(name);
-    crease()
-        .args(args)
-        .arg("-o")
-        .arg(&out)
-        .arg("-q")
-        .assert()
-        .success();
-    out
-}
 
 fn attr(geom: &crease::io::Geometry, name: &str) -> Vec<f64> {
     geom.points

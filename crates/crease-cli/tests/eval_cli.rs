@@ -2,19 +2,13 @@
 //! and AUC = 1, perturbed labels give the exact counts, the ROC CSV is written, and mismatched
 //! inputs fail with a message naming the file.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
+use common::{crease, json_of};
 use crease::geometry::Attribute;
 use crease::io::{Geometry, ReadOptions, WriteOptions};
-
-fn crease() -> Command {
-    Command::cargo_bin("crease").expect("the crease binary is built")
-}
-
-fn json_of(out: &[u8]) -> serde_json::Value {
-    serde_json::from_slice(out).expect("--json prints valid JSON on stdout")
-}
 
 fn synth(dir: &Path, name: &str, n: usize) -> PathBuf {
     let out = dir.join(name);

@@ -1,26 +1,10 @@
 //! End-to-end tests of `crease lines`: polylines written as OBJ / PLY, the per-stage JSON
 //! summary (the paper's Table 2), the segmentation output, and usage errors.
 
-use std::path::{Path, PathBuf};
+mod common;
 
-use assert_cmd::Command;
+use common::{crease, synth};
 use crease::io::ReadOptions;
-
-fn crease() -> Command {
-    Command::cargo_bin("crease").expect("the crease binary is built")
-}
-
-fn synth(dir: &Path, args: &[&str], name: &str) -> PathBuf {
-    let out = dir.join(name);
-    crease()
-        .args(args)
-        .arg("-o")
-        .arg(&out)
-        .arg("-q")
-        .assert()
-        .success();
-    out
-}
 
 #[test]
 fn two_cylinders_give_six_closed_loops() {

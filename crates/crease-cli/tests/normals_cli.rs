@@ -1,19 +1,13 @@
 //! End-to-end tests of `crease normals`: PCA and mesh normals written as `nx ny nz` beside the
 //! input's attributes in input order, orientation, the JSON summary, and clear errors.
 
+mod common;
+
 use std::path::Path;
 
-use assert_cmd::Command;
+use common::{crease, json_of};
 use crease::geometry::vec3;
 use crease::io::ReadOptions;
-
-fn crease() -> Command {
-    Command::cargo_bin("crease").expect("the crease binary is built")
-}
-
-fn json_of(out: &[u8]) -> serde_json::Value {
-    serde_json::from_slice(out).expect("--json prints valid JSON on stdout")
-}
 
 fn synth(dir: &Path, shape: &str, extra: &[&str]) -> std::path::PathBuf {
     let out = dir.join(format!("{shape}.ply"));

@@ -1,26 +1,10 @@
 //! End-to-end tests of `crease sharp` and `crease eval`: properties in input order, the
 //! detection scored against the synthetic labels, meshes, the JSON summary, and usage errors.
 
-use std::path::{Path, PathBuf};
+mod common;
 
-use assert_cmd::Command;
+use common::{crease, synth};
 use crease::io::ReadOptions;
-
-fn crease() -> Command {
-    Command::cargo_bin("crease").expect("the crease binary is built")
-}
-
-fn synth(dir: &Path, args: &[&str], name: &str) -> PathBuf {
-    let out = dir.join(name);
-    crease()
-        .args(args)
-        .arg("-o")
-        .arg(&out)
-        .arg("-q")
-        .assert()
-        .success();
-    out
-}
 
 #[test]
 fn cloud_detection_scored_by_eval() {

@@ -5,23 +5,10 @@ mod common;
 
 use crease::geometry::Point3;
 use crease::lines::{extract_lines, LineNetwork, LinesParams};
-use crease::synth::{self, CurveKind, Noise, NoiseScale, SampleParams, Shape, SyntheticPart};
+use crease::synth::{self, CurveKind, SyntheticPart};
 
 fn part(name: &str, n: usize, noise: f64) -> SyntheticPart {
-    synth::sample_points(
-        &Shape::from_name(name).expect("shape"),
-        &SampleParams {
-            n,
-            noise: if noise > 0.0 {
-                Noise::AlongNormal(noise)
-            } else {
-                Noise::None
-            },
-            noise_scale: NoiseScale::Spacing,
-            ..Default::default()
-        },
-    )
-    .expect("sample")
+    common::noisy_part(name, n, noise)
 }
 
 fn seg_dist(p: Point3, a: Point3, b: Point3) -> f64 {

@@ -10,7 +10,7 @@ use crease::eval::tolerant::{default_tolerance, tolerant_scores};
 use crease::eval::Confusion;
 use crease::geometry::{Point3, PointCloud};
 use crease::sharp::{detect_mesh, detect_points, Measure, SharpParams, ThresholdRule};
-use crease::synth::{self, MeshParams, Noise, NoiseScale, SampleParams, Shape};
+use crease::synth::{self, MeshParams, Noise, Shape, SyntheticPart};
 
 fn gt_sharp(cloud: &PointCloud) -> Vec<bool> {
     cloud
@@ -22,22 +22,8 @@ fn gt_sharp(cloud: &PointCloud) -> Vec<bool> {
         .collect()
 }
 
-fn part(name: &str, n: usize, noise: f64) -> synth::SyntheticPart {
-    let shape = Shape::from_name(name).expect("known shape");
-    synth::sample_points(
-        &shape,
-        &SampleParams {
-            n,
-            noise: if noise > 0.0 {
-                Noise::AlongNormal(noise)
-            } else {
-                Noise::None
-            },
-            noise_scale: NoiseScale::Spacing,
-            ..Default::default()
-        },
-    )
-    .expect("sampling works")
+fn part(name: &str, n: usize, noise: f64) -> SyntheticPart {
+    common::noisy_part(name, n, noise)
 }
 
 /// (exact F1, exact MCC, tolerant F1 at the default tolerance of 2 average spacings).

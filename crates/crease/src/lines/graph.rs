@@ -118,6 +118,35 @@ impl Graph {
     }
 }
 
+/// Union–find over vertex ids (path halving; the smaller root wins, so results are
+/// deterministic), for the spanning forests of steps 4 and the boundary.
+struct UnionFind(Vec<u32>);
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        UnionFind((0..n as u32).collect())
+    }
+
+    fn find(&mut self, mut x: u32) -> u32 {
+        while self.0[x as usize] != x {
+            let y = self.0[x as usize];
+            self.0[x as usize] = self.0[y as usize];
+            x = y;
+        }
+        x
+    }
+
+    /// Joins the sets of a and b; false if they were already one.
+    fn union(&mut self, a: u32, b: u32) -> bool {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra == rb {
+            return false;
+        }
+        self.0[ra.max(rb) as usize] = ra.min(rb);
+        true
+    }
+}
+
 /// The clusters as graph vertices: centre of mass and size (section 2.3).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Clusters {
@@ -265,23 +294,10 @@ pub fn pruned_mst(clusters: &Clusters, g: &Graph) -> Graph {
         })
         .collect();
     edges.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)));
-    let mut parent: Vec<u32> = (0..m as u32).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            let y = p[x as usize];
-            p[x as usize] = p[y as usize];
-            x = y;
-        }
-        x
-    }
+    let mut sets = UnionFind::new(m);
     let mut out = Graph::new(m);
     for (large, _, [a, b]) in edges {
-        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-        if ra == rb {
-            continue;
-        }
-        parent[ra.max(rb) as usize] = ra.min(rb);
-        if !large {
+        if sets.union(a, b) && !large {
             out.add_edge(a, b);
         }
     }
@@ -487,20 +503,10 @@ pub fn boundary_graph(
         }
     }
     links.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    let mut parent: Vec<u32> = (0..ids.len() as u32).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            let y = p[x as usize];
-            p[x as usize] = p[y as usize];
-            x = y;
-        }
-        x
-    }
+    let mut sets = UnionFind::new(ids.len());
     let mut g = Graph::new(ids.len());
     for (_, [a, b]) in links {
-        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-        if ra != rb {
-            parent[ra.max(rb) as usize] = ra.min(rb);
+        if sets.union(a, b) {
             g.add_edge(a, b);
         }
     }

@@ -24,3 +24,23 @@ pub fn data_dir() -> Option<PathBuf> {
 pub fn tempdir() -> tempfile::TempDir {
     tempfile::tempdir().expect("temporary directory")
 }
+
+/// A synthetic part of `n` points with Gaussian noise along the normal of `noise` × the
+/// expected spacing (none for 0).
+pub fn noisy_part(name: &str, n: usize, noise: f64) -> crease::synth::SyntheticPart {
+    use crease::synth::{Noise, NoiseScale, SampleParams, Shape};
+    crease::synth::sample_points(
+        &Shape::from_name(name).expect("known shape"),
+        &SampleParams {
+            n,
+            noise: if noise > 0.0 {
+                Noise::AlongNormal(noise)
+            } else {
+                Noise::None
+            },
+            noise_scale: NoiseScale::Spacing,
+            ..Default::default()
+        },
+    )
+    .expect("sampling works")
+}
