@@ -24,6 +24,8 @@ fn cloud_detection_scored_by_eval() {
     assert_eq!(summary["points"], 12000);
     assert_eq!(summary["scales"].as_array().unwrap().len(), 8);
     assert_eq!(summary["scales"][0]["scale"], 12);
+    assert!(summary["timings"]["knn"].as_f64().unwrap() >= 0.0);
+    assert!(summary["timings"]["detection"].as_f64().unwrap() >= 0.0);
     let (src, _) = crease::io::read(&input, &ReadOptions::default()).unwrap();
     let (res, _) = crease::io::read(&out, &ReadOptions::default()).unwrap();
     assert_eq!(
