@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{crease, synth};
+use common::{crease, run, synth};
 use crease::io::ReadOptions;
 
 #[test]
@@ -65,14 +65,7 @@ fn usage_errors() {
     let dir = tempfile::tempdir().unwrap();
     let input = synth(dir.path(), &["synth", "cube", "-n", "15"], "tiny.ply");
     let out = dir.path().join("o.obj");
-    let a = crease()
-        .arg("lines")
-        .arg(&input)
-        .arg("-o")
-        .arg(&out)
-        .assert()
-        .failure()
-        .code(1);
+    let a = run("lines", &input, &out, &[]).failure().code(1);
     let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
     assert!(
         err.contains("tiny.ply") && err.contains("15 points"),
@@ -83,22 +76,7 @@ fn usage_errors() {
         vec!["--alpha-max", "95"],
         vec!["-k", "2"],
     ] {
-        crease()
-            .arg("lines")
-            .arg(&input)
-            .arg("-o")
-            .arg(&out)
-            .args(&bad)
-            .assert()
-            .failure()
-            .code(2);
+        run("lines", &input, &out, &bad).failure().code(2);
     }
-    crease()
-        .arg("lines")
-        .arg(&input)
-        .arg("-o")
-        .arg(&input)
-        .assert()
-        .failure()
-        .code(2);
+    run("lines", &input, &input, &[]).failure().code(2);
 }

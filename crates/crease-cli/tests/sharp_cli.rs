@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{crease, synth};
+use common::{crease, run, synth};
 use crease::io::ReadOptions;
 
 #[test]
@@ -92,14 +92,7 @@ fn usage_errors_and_too_few_points() {
     let dir = tempfile::tempdir().unwrap();
     let input = synth(dir.path(), &["synth", "cube", "-n", "30"], "tiny.ply");
     let out = dir.path().join("o.ply");
-    let a = crease()
-        .arg("sharp")
-        .arg(&input)
-        .arg("-o")
-        .arg(&out)
-        .assert()
-        .failure()
-        .code(1);
+    let a = run("sharp", &input, &out, &[]).failure().code(1);
     let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
     assert!(
         err.contains("tiny.ply") && err.contains("30 points"),
@@ -111,23 +104,8 @@ fn usage_errors_and_too_few_points() {
         vec!["--scales", "0,12"],
         vec!["--upper-quantile", "0"],
     ] {
-        crease()
-            .arg("sharp")
-            .arg(&input)
-            .arg("-o")
-            .arg(&out)
-            .args(&bad)
-            .assert()
-            .failure()
-            .code(2);
+        run("sharp", &input, &out, &bad).failure().code(2);
     }
     // Never overwrite the input.
-    crease()
-        .arg("sharp")
-        .arg(&input)
-        .arg("-o")
-        .arg(&input)
-        .assert()
-        .failure()
-        .code(2);
+    run("sharp", &input, &input, &[]).failure().code(2);
 }

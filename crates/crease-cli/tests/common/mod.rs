@@ -28,3 +28,14 @@ pub fn synth(dir: &Path, args: &[&str], name: &str) -> PathBuf {
 pub fn json_of(out: &[u8]) -> serde_json::Value {
     serde_json::from_slice(out).expect("--json prints valid JSON on stdout")
 }
+
+/// Runs `crease CMD INPUT -o OUTPUT EXTRA...` and returns its assertion handle.
+pub fn run(cmd: &str, input: &Path, output: &Path, extra: &[&str]) -> assert_cmd::assert::Assert {
+    crease()
+        .arg(cmd)
+        .arg(input)
+        .arg("-o")
+        .arg(output)
+        .args(extra)
+        .assert()
+}

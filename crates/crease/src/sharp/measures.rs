@@ -66,24 +66,25 @@ pub(crate) struct LocalPca {
     pub rms_radius: f64,
 }
 
-/// Weighted PCA (tran equation 1) of `{p_i} ∪ rows(i)`; `scratch` is reused.
+/// Weighted PCA (tran equation 1) of `{p_i} ∪ rows(i)`; `scratch` (gathered coordinates, work
+/// space) is reused between calls.
 #[inline]
 pub(crate) fn local_pca(
     points: &[Point3],
     i: usize,
     row: &[u32],
     weight: PcaWeight,
-    scratch: &mut Vec<Point3>,
+    scratch: &mut Scratch,
 ) -> LocalPca {
-    let mut coords = std::mem::take(scratch);
+    let (coords, work) = scratch;
     coords.clear();
     coords.push(points[i]);
     coords.extend(row.iter().map(|&j| points[j as usize]));
-    let mut work = Vec::with_capacity(coords.len());
-    let l = local_pca_coords(&coords, weight, &mut work);
-    *scratch = coords;
-    l
+    local_pca_coords(coords, weight, work)
 }
+
+/// Per-thread buffers of [`local_pca`]: gathered coordinates and work space.
+pub(crate) type Scratch = (Vec<Point3>, Vec<Point3>);
 
 /// Weighted PCA of `coords` (`coords[0]` the point, then its neighbours), with the two-sheet
 /// test of [`own_sheet`] (whose tau selects the point's own sheet); `work` is scratch.
@@ -320,7 +321,7 @@ where
         Measure::ProjectedDistance | Measure::SurfaceVariation => (0..n)
             .into_par_iter()
             .with_min_len(256)
-            .map_init(Vec::new, |scratch, i| {
+            .map_init(Scratch::default, |scratch, i| {
                 let l = local_pca(points, i, rows(i), weight, scratch);
                 pca_value(&l, fixed_normals.map(|f| f[i]), measure, density_invariant)
             })
@@ -333,7 +334,7 @@ where
                     computed = (0..n)
                         .into_par_iter()
                         .with_min_len(256)
-                        .map_init(Vec::new, |scratch, i| {
+                        .map_init(Scratch::default, |scratch, i| {
                             local_pca(points, i, rows(i), weight, scratch).normal
                         })
                         .collect::<Vec<_>>();
