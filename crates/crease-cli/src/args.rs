@@ -61,6 +61,10 @@ pub enum Command {
     Normals(crate::commands::normals::NormalsArgs),
     /// Closed sharp feature lines of a point cloud (Demarsin 2007 graph pipeline).
     Lines(crate::commands::lines::LinesArgs),
+    /// Fillet (smooth-edge) lines of a point cloud (Demarsin 2008 curvature histograms).
+    Fillets(crate::commands::fillets::FilletsArgs),
+    /// The whole curve network of a point cloud: sharp and fillet lines together.
+    Network(crate::commands::fillets::FilletsArgs),
     /// Sharp feature points (multi-scale projected distance with automatic thresholds).
     Sharp(crate::commands::sharp::SharpArgs),
     /// Score a labelled output against ground truth: precision, recall, F1, MCC, IoU, tolerant

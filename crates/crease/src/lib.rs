@@ -14,6 +14,7 @@
 pub mod error;
 pub mod estimate;
 pub mod eval;
+pub mod fillets;
 pub mod geometry;
 pub mod graphcut;
 pub mod io;

@@ -84,6 +84,7 @@ fn rich_geometry() -> Geometry {
         edges,
         edge_attributes,
         polylines,
+        polyline_groups: Vec::new(),
     }
 }
 
@@ -737,6 +738,7 @@ fn geometry_strategy() -> impl Strategy<Value = Geometry> {
                     edges,
                     edge_attributes,
                     polylines,
+                    polyline_groups: Vec::new(),
                 }
             },
         )

@@ -4,6 +4,7 @@ mod convert;
 pub mod curvature;
 mod demo;
 pub(crate) mod eval;
+pub(crate) mod fillets;
 mod info;
 pub(crate) mod lines;
 pub(crate) mod normals;
@@ -36,6 +37,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sharp(a) => sharp::run(g, &a),
         Command::Lines(a) => lines::run(g, &a),
         Command::Eval(a) => eval::run(g, &a),
+        Command::Fillets(a) => fillets::run(g, &a, false),
+        Command::Network(a) => fillets::run(g, &a, true),
     }
 }
 

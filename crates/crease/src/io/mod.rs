@@ -39,6 +39,9 @@ pub struct Geometry {
     pub edge_attributes: Attributes,
     /// Polylines as point-index chains (OBJ `l`). A closed loop repeats its first index at the end.
     pub polylines: Vec<Vec<u32>>,
+    /// Optional group name of every polyline (OBJ `g` before each run of equal names, e.g.
+    /// `sharp` / `smooth` lines of a curve network); empty for none. Not stored in PLY.
+    pub polyline_groups: Vec<String>,
 }
 
 impl Geometry {

@@ -102,7 +102,13 @@ pub fn write(path: &Path, geom: &Geometry, _opts: &WriteOptions) -> Result<()> {
     })
     .map_err(io)?;
     let mut buf = Vec::new();
-    for l in &geom.polylines {
+    let grouped = geom.polyline_groups.len() == geom.polylines.len();
+    let mut group: Option<&str> = None;
+    for (i, l) in geom.polylines.iter().enumerate() {
+        if grouped && group != Some(geom.polyline_groups[i].as_str()) {
+            group = Some(geom.polyline_groups[i].as_str());
+            writeln!(w, "g {}", geom.polyline_groups[i]).map_err(io)?;
+        }
         buf.clear();
         buf.push(b'l');
         for &v in l {

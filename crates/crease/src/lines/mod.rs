@@ -46,7 +46,7 @@ pub use graph::{CloseReport, Graph};
 pub use segment::{region_grow, Segmentation};
 
 use crate::estimate::ring_normals;
-use crate::geometry::{chain_segments, Point3};
+use crate::geometry::{chain_segments, Csr, Point3};
 use crate::spatial::{delaunay_rings, knn, RingParams};
 use crate::{Error, Result};
 
@@ -157,10 +157,38 @@ impl LineNetwork {
     }
 }
 
-/// Runs the pipeline (see the module documentation) on `points`.
-///
-/// Errors: fewer than k + 1 points, non-finite coordinates, invalid parameters.
-pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetwork> {
+/// How step 7 moves the network's vertices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Smoothing {
+    /// Leave the vertices at their clusters' centres of mass.
+    None,
+    /// Sharp lines: onto the local intersection of the adjacent smooth patches' planes
+    /// ([`smooth::smooth_vertices`]).
+    PatchIntersection,
+    /// Smooth lines (fillet borders), where the adjacent patches are tangent and their planes do
+    /// not intersect: Laplacian smoothing along the polylines, then back onto the cloud's local
+    /// plane ([`smooth::smooth_along`]).
+    AlongLine,
+}
+
+/// The first-order structure of section 2.2 that both the sharp and the smooth pipelines stand
+/// on: the symmetrised Delaunay 1-ring adjacency, the boundary flags, the 1-ring normals and the
+/// region growing on them.
+#[derive(Debug, Clone)]
+pub struct FirstOrder {
+    /// Symmetrised 1-ring adjacency (p, q adjacent when either is in the other's ring).
+    pub adjacency: Csr,
+    /// Points on the cloud's boundary (hull of their projected neighbours).
+    pub boundary: Vec<bool>,
+    /// Least-squares plane normals of the 1-rings.
+    pub normals: Vec<Point3>,
+    /// Region growing with α_max on the normals.
+    pub segmentation: Segmentation,
+    /// Seconds spent.
+    pub seconds: f64,
+}
+
+fn check_params(params: &LinesParams) -> Result<()> {
     if !(params.alpha_max_degrees > 0.0 && params.alpha_max_degrees < 90.0) {
         return Err(Error::InvalidArgument(format!(
             "alpha_max must be in (0, 90) degrees, got {}",
@@ -173,20 +201,76 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
             params.k, params.d_max
         )));
     }
-    let mut stages = Vec::new();
+    Ok(())
+}
+
+/// Step 1 (section 2.2): Delaunay 1-rings of the `params.k` nearest neighbours, their normals,
+/// and region growing with `params.alpha_max_degrees`.
+///
+/// Errors: fewer than k + 1 points, non-finite coordinates, invalid parameters.
+pub fn first_order(points: &[Point3], params: &LinesParams) -> Result<FirstOrder> {
+    check_params(params)?;
     let t = Instant::now();
     let nbrs = knn(points, params.k)?;
     let rings = delaunay_rings(points, &nbrs, &RingParams { k: params.k })?;
     drop(nbrs);
     let normals = ring_normals(points, &rings);
     let adjacency = rings.symmetrized();
-    let boundary_flags = rings.boundary.clone();
+    let boundary = rings.boundary.clone();
     drop(rings);
-    let seg = region_grow(&normals, &adjacency, params.alpha_max_degrees.to_radians());
-    let seg_seconds = t.elapsed().as_secs_f64();
+    let segmentation = region_grow(&normals, &adjacency, params.alpha_max_degrees.to_radians());
+    Ok(FirstOrder {
+        adjacency,
+        boundary,
+        normals,
+        segmentation,
+        seconds: t.elapsed().as_secs_f64(),
+    })
+}
 
+/// Runs the pipeline (see the module documentation) on `points`.
+///
+/// Errors: fewer than k + 1 points, non-finite coordinates, invalid parameters.
+pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetwork> {
+    let first = first_order(points, params)?;
+    let boundary = params.boundary.then_some(first.boundary.as_slice());
+    let smoothing = if params.smooth {
+        Smoothing::PatchIntersection
+    } else {
+        Smoothing::None
+    };
+    network(
+        points,
+        first.segmentation.clone(),
+        &first.adjacency,
+        boundary,
+        params,
+        smoothing,
+        first.seconds,
+    )
+}
+
+/// Steps 2 to 7 on any segmentation of `points` into large clusters (patches) bounded by small
+/// clusters (the feature): the sharp lines run it on the 1-ring-normal segmentation, the fillet
+/// lines of [`crate::fillets`] on their curvature-label segmentation. `adjacency` is the
+/// symmetric point adjacency the segmentation grew over; `boundary`, when given, flags the
+/// points whose boundary lines join the graph before the close step; `seg_seconds` is added to
+/// the first stage's time.
+///
+/// Errors: invalid parameters.
+pub fn network(
+    points: &[Point3],
+    seg: Segmentation,
+    adjacency: &Csr,
+    boundary: Option<&[bool]>,
+    params: &LinesParams,
+    smoothing: Smoothing,
+    seg_seconds: f64,
+) -> Result<LineNetwork> {
+    check_params(params)?;
+    let mut stages = Vec::new();
     let t = Instant::now();
-    let (mut clusters, mut g) = graph::build_all(points, &seg.labels, &seg.sizes, &adjacency);
+    let (mut clusters, mut g) = graph::build_all(points, &seg.labels, &seg.sizes, adjacency);
     stages.push(Stage {
         name: "segmentation+G_all",
         vertices: g.num_active_vertices(),
@@ -220,9 +304,9 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
     // The cloud's boundary joins the graph just before the close step (Fig. 9).
     let num_clusters = g.num_vertices();
     let mut boundary_points = 0;
-    if params.boundary && boundary_flags.iter().any(|&b| b) {
+    if let Some(flags) = boundary.filter(|f| f.iter().any(|&b| b)) {
         let t = Instant::now();
-        let (ids, bg) = graph::boundary_graph(points, &boundary_flags, &adjacency, params.d_max);
+        let (ids, bg) = graph::boundary_graph(points, flags, adjacency, params.d_max);
         boundary_points = bg.num_active_vertices();
         g.append(&bg);
         for &i in &ids {
@@ -232,7 +316,6 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
         }
         timed("boundary", &bg, t);
     }
-    drop(adjacency);
     let n = params.n.unwrap_or(2 * params.d_max);
     let d = params.d.unwrap_or(2 * params.d_max);
     let t = Instant::now();
@@ -261,16 +344,16 @@ pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetw
     let polylines = chain_segments(vertices.len(), &edges);
     let t = Instant::now();
     let unsmoothed = vertices.clone();
-    let vertices = if params.smooth {
-        smooth::smooth_vertices(
+    let vertices = match smoothing {
+        Smoothing::None => vertices,
+        Smoothing::PatchIntersection => smooth::smooth_vertices(
             points,
             &seg.labels,
             &clusters.small,
             &vertices,
             3 * params.k,
-        )
-    } else {
-        vertices
+        ),
+        Smoothing::AlongLine => smooth::smooth_along(points, &vertices, &edges, params.k),
     };
     stages.push(Stage {
         name: "G_smooth",

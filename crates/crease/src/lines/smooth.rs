@@ -117,6 +117,65 @@ fn line_point(
     corner(a, b, &(p, dir))
 }
 
+/// Laplacian iterations of [`smooth_along`].
+const ALONG_ITERATIONS: usize = 3;
+
+/// Smoothing for lines between tangent-continuous patches (fillet borders, demarsin2008
+/// section 3, which keeps the step of demarsin2007 without detail): the patches' planes are
+/// parallel there, so [`smooth_vertices`] has nothing to intersect. Every vertex of degree 2 in
+/// `edges` is moved `ALONG_ITERATIONS` times halfway towards the midpoint of its two neighbours
+/// (Jacobi iterations; endpoints and junctions stay, so corners of the network stay where they
+/// are), which removes the zig-zag of one-point clusters across the border, and then projected
+/// onto the least-squares plane of its `k` nearest cloud points, which keeps it on the surface
+/// (the Laplacian step cuts a curved line's chords by a fraction of a spacing).
+pub fn smooth_along(
+    points: &[Point3],
+    vertices: &[Point3],
+    edges: &[[u32; 2]],
+    k: usize,
+) -> Vec<Point3> {
+    let n = vertices.len();
+    let mut nbrs: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for &[a, b] in edges {
+        if (a as usize) < n && (b as usize) < n && a != b {
+            nbrs[a as usize].push(b);
+            nbrs[b as usize].push(a);
+        }
+    }
+    let mut cur = vertices.to_vec();
+    for _ in 0..ALONG_ITERATIONS {
+        cur = (0..n)
+            .into_par_iter()
+            .map(|v| match nbrs[v].as_slice() {
+                &[a, b] => {
+                    let mid = vec3::scale(vec3::add(cur[a as usize], cur[b as usize]), 0.5);
+                    vec3::scale(vec3::add(cur[v], mid), 0.5)
+                }
+                _ => cur[v],
+            })
+            .collect();
+    }
+    let Some(index) = KdIndex::new(points) else {
+        return cur;
+    };
+    cur.par_iter()
+        .enumerate()
+        .map(|(v, &c)| {
+            if nbrs[v].len() != 2 {
+                return c;
+            }
+            let near = index.nearest(&c, k.min(points.len()));
+            match fit_plane(near.iter().map(|&(j, _)| (points[j as usize], 1.0))) {
+                Some(pl) => {
+                    let off = vec3::dot(vec3::sub(c, pl.centroid), pl.normal);
+                    vec3::sub(c, vec3::scale(pl.normal, off))
+                }
+                None => c,
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,287 @@
+//! `crease fillets IN -o FILLETS.obj [--labels LABELS.ply]`: fillet (smooth-edge) lines of a
+//! point cloud by multi-resolution curvature histograms (Demarsin et al. 2008,
+//! `crease::fillets`), and `crease network IN -o NET.obj`: the whole curve network, sharp and
+//! smooth lines together (OBJ groups `sharp` / `smooth`; PLY vertex property `smooth`).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use crease::fillets::{
+    curve_network, extract_fillets, FilletParams, Fillets, Label, Search, ThresholdCount,
+};
+use crease::geometry::{Attribute, PointCloud};
+use crease::io::Geometry;
+use crease::lines::LinesParams;
+
+use crate::args::Global;
+use crate::ui::{usage, Stage};
+
+/// Arguments of `crease fillets` and `crease network`.
+#[derive(Args, Debug)]
+pub struct FilletsArgs {
+    /// Point cloud (a mesh's vertices are used as points).
+    pub input: PathBuf,
+    /// Output polylines (.obj writes `l` lines; .ply writes vertices and an `edge` element).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write per-point labels to this file: `fillet_label` (0 low, 1 inner, 2 border,
+    /// 3 noisy, 255 outside the smooth regions), `smooth_edge` (1 on a fillet border),
+    /// `patch` (curvature patch, 255 outside), `region` (-1 outside), `mean_curvature`.
+    #[arg(long)]
+    pub labels: Option<PathBuf>,
+    /// Nearest neighbours triangulated for the Delaunay 1-rings.
+    #[arg(short, default_value_t = 20)]
+    pub k: usize,
+    /// Region-growing angle threshold between adjacent normals, degrees (the sharp edges that
+    /// bound the smooth regions).
+    #[arg(long, default_value_t = 8.0)]
+    pub alpha_max: f64,
+    /// Maximum length of the branches pruned by Algorithm 2.
+    #[arg(long, default_value_t = 5)]
+    pub d_max: usize,
+    /// Neighbours of the quadric fit of the mean curvature.
+    #[arg(long, default_value_t = 20)]
+    pub curvature_k: usize,
+    /// Taubin smoothing iterations of each smooth region before the curvature (section 2.4).
+    #[arg(long, default_value_t = 0)]
+    pub smoothing: usize,
+    /// Median-filter passes over the signed mean curvature.
+    #[arg(long, default_value_t = 1)]
+    pub median: usize,
+    /// Fraction of the highest curvatures left out of the histogram (section 2.4).
+    #[arg(long, default_value_t = 0.005)]
+    pub trim: f64,
+    /// Start resolution of the histogram, L_start (section 2.2).
+    #[arg(long, default_value_t = 50)]
+    pub bins: usize,
+    /// Use the paper's one-run search (start_curv = min only) instead of the full search.
+    #[arg(long)]
+    pub one_run: bool,
+    /// Thresholds per smooth region: `auto` (decided per region) or a number (the splits
+    /// of largest ratio are taken).
+    #[arg(long, default_value = "auto")]
+    pub thresholds: String,
+    /// Upper bound of `--thresholds auto`.
+    #[arg(long, default_value_t = 4)]
+    pub max_thresholds: usize,
+    /// Curvature thresholds given by hand (comma-separated, used in every region).
+    #[arg(long, value_delimiter = ',')]
+    pub tau: Vec<f64>,
+    /// Leave the cloud's boundary out of the network.
+    #[arg(long)]
+    pub no_boundary: bool,
+    /// Write text instead of binary where the format has both.
+    #[arg(long)]
+    pub ascii: bool,
+}
+
+fn params(a: &FilletsArgs) -> anyhow::Result<FilletParams> {
+    if !(a.alpha_max > 0.0 && a.alpha_max < 90.0) {
+        return Err(usage(format!(
+            "--alpha-max must be in (0, 90) degrees, got {}",
+            a.alpha_max
+        )));
+    }
+    if a.k < 3 || a.d_max == 0 || a.curvature_k < 5 || a.bins < 4 {
+        return Err(usage(
+            "-k must be at least 3, --curvature-k at least 5, --bins at least 4 and --d-max positive"
+                .to_string(),
+        ));
+    }
+    if !(0.0..0.5).contains(&a.trim) {
+        return Err(usage(format!("--trim must be in [0, 0.5), got {}", a.trim)));
+    }
+    let thresholds = if !a.tau.is_empty() {
+        if a.tau.iter().any(|t| !t.is_finite() || *t < 0.0) {
+            return Err(usage(
+                "--tau values must be non-negative numbers".to_string(),
+            ));
+        }
+        ThresholdCount::Manual(a.tau.clone())
+    } else if a.thresholds == "auto" {
+        ThresholdCount::Auto {
+            max: a.max_thresholds,
+        }
+    } else {
+        match a.thresholds.parse::<usize>() {
+            Ok(n) => ThresholdCount::Exactly(n),
+            Err(_) => {
+                return Err(usage(format!(
+                    "--thresholds must be `auto` or a number, got `{}`",
+                    a.thresholds
+                )))
+            }
+        }
+    };
+    Ok(FilletParams {
+        lines: LinesParams {
+            k: a.k,
+            alpha_max_degrees: a.alpha_max,
+            d_max: a.d_max,
+            boundary: !a.no_boundary,
+            ..Default::default()
+        },
+        curvature_k: a.curvature_k,
+        smoothing_iterations: a.smoothing,
+        median_iterations: a.median,
+        trim: a.trim,
+        bins: a.bins,
+        search: if a.one_run {
+            Search::OneRun
+        } else {
+            Search::Full
+        },
+        thresholds,
+        ..Default::default()
+    })
+}
+
+/// `crease fillets` (`network` false) and `crease network` (`network` true).
+pub fn run(g: &Global, a: &FilletsArgs, network: bool) -> anyhow::Result<()> {
+    crease::io::Format::from_path(&a.output).map_err(|e| usage(e.to_string()))?;
+    crate::ui::ensure_not_input(&a.output, &[&a.input])?;
+    if let Some(s) = &a.labels {
+        crease::io::Format::from_path(s).map_err(|e| usage(e.to_string()))?;
+        crate::ui::ensure_not_input(s, &[&a.input])?;
+    }
+    let params = params(a)?;
+    let (geom, report) = super::load(g, &a.input)?;
+    let n_points = geom.points.len();
+    let need = a.k.max(a.curvature_k) + 1;
+    if n_points < need {
+        anyhow::bail!(
+            "{}: {n_points} points, fillet lines need at least {need}",
+            a.input.display()
+        );
+    }
+    let start = Instant::now();
+    let stage = Stage::start(
+        if network {
+            "curve network (Demarsin 2007 + 2008)"
+        } else {
+            "fillet lines (Demarsin 2008)"
+        },
+        g.quiet,
+    );
+    let f = extract_fillets(&geom.points.positions, &params, network)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+    stage.finish();
+    let seconds = start.elapsed().as_secs_f64();
+
+    let mut out;
+    let summary_lines;
+    if network {
+        let net = curve_network(&f);
+        let mut cloud = PointCloud::from_positions(net.vertices.clone());
+        let mut smooth_vertex = vec![false; net.vertices.len()];
+        for (l, &s) in net.polylines.iter().zip(&net.smooth) {
+            if s {
+                for &v in l {
+                    smooth_vertex[v as usize] = true;
+                }
+            }
+        }
+        cloud.set_attribute(Attribute::flag("smooth", smooth_vertex))?;
+        out = Geometry::from_cloud(cloud);
+        out.polylines = net.polylines.clone();
+        out.polyline_groups = net
+            .smooth
+            .iter()
+            .map(|&s| if s { "smooth" } else { "sharp" }.to_string())
+            .collect();
+        let sharp_lines = net.smooth.iter().filter(|&&s| !s).count();
+        summary_lines = serde_json::json!({
+            "sharp_polylines": sharp_lines,
+            "smooth_polylines": net.polylines.len() - sharp_lines,
+            "joined_smooth_ends": net.joined_ends,
+            "open_smooth_ends": net.open_ends,
+        });
+    } else {
+        out = Geometry::from_cloud(PointCloud::from_positions(f.lines.vertices.clone()));
+        out.polylines = f.lines.polylines.clone();
+        summary_lines = serde_json::json!({});
+    }
+    super::save(g, &a.output, &out, a.ascii, &[&a.input])?;
+    if let Some(path) = &a.labels {
+        let cloud = labelled(&geom.points, &f)?;
+        super::save(g, path, &Geometry::from_cloud(cloud), a.ascii, &[&a.input])?;
+    }
+    let border = f
+        .label
+        .iter()
+        .filter(|l| **l == Some(Label::Border))
+        .count();
+    if g.json {
+        let summary = serde_json::json!({
+            "input": a.input, "output": a.output, "points": n_points,
+            "dropped_nonfinite": report.dropped_nonfinite,
+            "smooth_regions": f.regions.len(),
+            "regions": f.regions,
+            "border_points": border,
+            "polylines": f.lines.polylines.len(),
+            "closed_loops": f.lines.closed_loops(),
+            "junctions": f.lines.junctions(),
+            "endpoints": f.lines.endpoints(),
+            "network": summary_lines,
+            "sharp_stages": f.sharp.as_ref().map(|s| &s.stages),
+            "timing": f.seconds,
+            "seconds": seconds,
+        });
+        crate::ui::print_json(&summary)?;
+    } else if !g.quiet {
+        let accepted: usize = f
+            .regions
+            .iter()
+            .map(|r| r.thresholds.iter().filter(|t| t.accepted).count())
+            .sum();
+        eprintln!(
+            "wrote {}: {} smooth polylines ({} closed loops, {} endpoints) from {} smooth regions \
+             and {} thresholds, {:.2} s",
+            a.output.display(),
+            f.lines.polylines.len(),
+            f.lines.closed_loops(),
+            f.lines.endpoints(),
+            f.regions.len(),
+            accepted,
+            seconds
+        );
+        if let Some(s) = &f.sharp {
+            eprintln!(
+                "  with {} sharp polylines ({} closed loops)",
+                s.polylines.len(),
+                s.closed_loops()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The input cloud with the per-point fillet outputs as properties.
+fn labelled(points: &PointCloud, f: &Fillets) -> anyhow::Result<PointCloud> {
+    let mut cloud = points.clone();
+    let code = |l: Option<Label>| l.map_or(255u8, |l| l as u8);
+    cloud.set_attribute(uchar("fillet_label", f.label.iter().map(|&l| code(l))))?;
+    cloud.set_attribute(Attribute::flag(
+        "smooth_edge",
+        f.label.iter().map(|&l| l == Some(Label::Border)),
+    ))?;
+    cloud.set_attribute(uchar("patch", f.patch.iter().copied()))?;
+    cloud.set_attribute(Attribute::int(
+        "region",
+        f.region
+            .iter()
+            .map(|&r| if r == u32::MAX { -1 } else { r as i64 }),
+    ))?;
+    cloud.set_attribute(Attribute::float("mean_curvature", f.curvature.clone()))?;
+    Ok(cloud)
+}
+
+/// A `uchar` attribute.
+fn uchar(name: &str, values: impl IntoIterator<Item = u8>) -> Attribute {
+    Attribute {
+        name: name.to_string(),
+        kind: crease::geometry::ScalarKind::U8,
+        values: values.into_iter().map(f64::from).collect(),
+    }
+}
