@@ -98,7 +98,7 @@ fn rounded_cube_lines_and_thresholds() {
 /// elsewhere (the chamfer and the cone are bounded by sharp edges), and in the whole network
 /// the 4 ends of the two fillet lines meet the sharp lines of the box's end faces. Measured
 /// (100k points): noiseless 2 polylines, both curves covered, 99 % of the vertices within 2
-/// spacings; with noise of 5 % of the spacing both covered, 91 %, but 37 polylines.
+/// spacings; with noise of 5 % of the spacing the same 2 polylines, 96 %.
 #[test]
 fn fillet_block_clean_and_noisy() {
     let (part, f) = run("fillet-chamfer-cone", 100_000, 0.0);
@@ -116,7 +116,26 @@ fn fillet_block_clean_and_noisy() {
     let (cover, close) = score(&part, &f);
     println!("noise 5 %: cover {cover:?}, close {close:.3}");
     assert!(cover.iter().all(|&c| c >= 0.9), "{cover:?}");
-    assert!(close >= 0.85, "{close}");
+    assert!(close >= 0.9, "{close}");
+    assert_eq!(f.lines.polylines.len(), 2);
+    assert_eq!(curve_network(&f).joined_ends, 4);
+}
+
+/// With noise of 5 % of the spacing the rounded cube keeps its 6 face loops (the borders
+/// between the planes and the fillets, 24 of the 48 curves), closed, and no spurious line; the
+/// corner patches (2 % of the points, |H| = 10 against 5) are lost in the noise of the
+/// curvature. Measured (100k points): 6 closed loops, 98 % of the vertices within 2 spacings.
+#[test]
+fn rounded_cube_with_noise_keeps_the_face_loops() {
+    let (part, f) = run("rounded-cube", 100_000, 0.05);
+    let (cover, close) = score(&part, &f);
+    let covered = cover.iter().filter(|&&c| c >= 0.9).count();
+    println!("covered {covered}/{}, close {close:.3}", cover.len());
+    assert!(covered >= 24, "{cover:?}");
+    assert!(close >= 0.95, "{close}");
+    assert_eq!(f.lines.endpoints(), 0);
+    assert_eq!(f.lines.junctions(), 0);
+    assert!(f.lines.closed_loops() >= 6);
 }
 
 /// Parts without fillets get no smooth line, with noise: planes, cylinders, cones and spheres

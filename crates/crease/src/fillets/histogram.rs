@@ -43,7 +43,7 @@ pub struct Split {
     pub b1: u64,
     /// b2: values in the joined valley bin.
     pub b2: u64,
-    /// b3: the most populated run of k bins from the valley's start on (the next peak).
+    /// b3: the most populated run of k bins after the valley (the next peak).
     pub b3: u64,
 }
 
@@ -138,9 +138,9 @@ pub fn ranked(values: &[f64], lo: f64, hi: f64, bins: usize, search: Search) -> 
     for s in at.iter_mut().flatten() {
         let k = s.joined;
         let t = ((s.tau - lo) / width).round() as usize;
-        // Windows of k bins from the valley's start on, clipped at the histogram's end (a
-        // narrow top mode may sit in the last few bins).
-        s.b3 = (t..bins)
+        // Windows of k bins after the valley, clipped at the histogram's end (a narrow top
+        // mode may sit in the last few bins).
+        s.b3 = (t + k..bins)
             .map(|j| prefix[(j + k).min(bins)] - prefix[j])
             .max()
             .unwrap_or(0);

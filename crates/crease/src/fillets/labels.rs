@@ -48,7 +48,14 @@ impl Label {
 /// Labels every point of `values` (curvatures) for the threshold `tau` over the symmetric
 /// adjacency `adjacency` (points without a row have no neighbours). Non-finite values are low.
 pub fn label(values: &[f64], tau: f64, adjacency: &Csr) -> Vec<Label> {
-    let high = |i: usize| values[i] > tau;
+    let high: Vec<bool> = values.iter().map(|&v| v > tau).collect();
+    label_high(&high, adjacency)
+}
+
+/// Labels from a high / low split (see [`label`]).
+pub fn label_high(high: &[bool], adjacency: &Csr) -> Vec<Label> {
+    let len = high.len();
+    let high = |i: usize| high[i];
     let row = |i: usize| {
         if i < adjacency.num_rows() {
             adjacency.row(i)
@@ -56,11 +63,11 @@ pub fn label(values: &[f64], tau: f64, adjacency: &Csr) -> Vec<Label> {
             &[]
         }
     };
-    let inner: Vec<bool> = (0..values.len())
+    let inner: Vec<bool> = (0..len)
         .into_par_iter()
         .map(|i| high(i) && row(i).iter().all(|&q| high(q as usize)))
         .collect();
-    (0..values.len())
+    (0..len)
         .into_par_iter()
         .map(|i| {
             if !high(i) {

@@ -4,8 +4,11 @@
 //! 1. **Smooth regions** (section 1.2): the first-order segmentation of demarsin2007
 //!    ([`crate::lines::first_order`]: Delaunay 1-ring normals, region growing with α_max = 8°)
 //!    splits the cloud along its sharp edges; its large clusters are the parts enclosed by sharp
-//!    lines (and the boundary), each treated separately. The small clusters (the sharp-edge
-//!    bands) belong to no smooth region.
+//!    lines (and the boundary), each treated separately. The small clusters along sharp edges
+//!    (those between two or more large clusters) belong to no smooth region; groups of small
+//!    clusters that touch only one large cluster are noise islands and join its region
+//!    (crease's addition: otherwise each island punches a hole with a boundary into the
+//!    region, and at 5 % noise the fillet graph wires dozens of spurious lines to them).
 //! 2. **Per region**: optional Laplacian smoothing (section 2.4; crease uses Taubin's λ|μ
 //!    variant, which does not shrink the fillets whose curvature is being measured), then the
 //!    mean curvature |H| of a quadric fitted over the k nearest neighbours *within the region*
@@ -16,8 +19,8 @@
 //!    left out of the histogram (section 2.4), and τ maximises ε = b1 / b2 over the start
 //!    histogram of `L_start` = 50 bins. Section 2.3 asks a user whether another threshold below
 //!    or above is needed; crease decides (see [`ThresholdCount::Auto`]): a threshold is
-//!    accepted when it cuts a valley (ε ≥ [`MIN_RATIO`], and the peak after it is as far above
-//!    the valley, b3 / b2 ≥ [`MIN_RATIO`]: a continuous curvature ramp such as a cone's has no
+//!    accepted when it cuts a valley (ε ≥ [`MIN_RATIO`], and the peak after it stands above
+//!    the valley, b3 / b2 ≥ [`MIN_RIGHT_RATIO`]: a continuous curvature ramp such as a cone's has no
 //!    such second peak), when the two sides' median curvatures differ by [`MIN_CONTRAST`], and
 //!    when both sides are patches, not a noise
 //!    tail or the transition between two patches: within the interval it splits, the points
@@ -55,6 +58,12 @@ use crate::{Error, Result};
 /// joined peak bin. A histogram without a valley (one mode) has its maximum ratio in the tail,
 /// where the inner-patch test rejects it.
 pub const MIN_RATIO: f64 = 2.0;
+
+/// Smallest b3 / b2 of an accepted threshold: the peak after the valley is half as high
+/// again as the valley. Lower than [`MIN_RATIO`] because the next peak is usually the smaller
+/// patch (fillets beside large planes), whose noisy curvature also spreads over more bins; a
+/// continuous ramp of curvature (a cone) has b3 ≤ b2.
+pub const MIN_RIGHT_RATIO: f64 = 1.5;
 
 /// Smallest relative difference (high − low) / high of the median curvatures on the two
 /// sides of an accepted threshold: patches of one analytic surface (a cylinder's curvature
@@ -351,9 +360,10 @@ pub fn extract_fillets(
         .min_region_points
         .max(params.curvature_k + 1)
         .max(params.bins);
+    let owner = island_owners(&seg.labels, &seg.sizes, mean, &first.adjacency);
     let mut members: Vec<Vec<u32>> = vec![Vec::new(); seg.num_clusters()];
     for (i, &l) in seg.labels.iter().enumerate() {
-        members[l as usize].push(i as u32);
+        members[owner[l as usize] as usize].push(i as u32);
     }
     let n = points.len();
     let mut out = Fillets {
@@ -368,7 +378,7 @@ pub fn extract_fillets(
     };
     for (c, ids) in members.iter().enumerate() {
         let size = ids.len();
-        if (size as f64) < mean || size < min_points {
+        if (seg.sizes[c] as f64) < mean || size < min_points {
             continue;
         }
         let region_id = out.regions.len() as u32;
@@ -388,6 +398,72 @@ pub fn extract_fillets(
         });
     }
     Ok(out)
+}
+
+/// The smooth region every first-order cluster belongs to: a large cluster to itself; a group
+/// of adjacent small clusters that touches exactly one large cluster (a noise island inside a
+/// smooth patch, section 3 of demarsin2007: "small clusters are created at the noisy parts")
+/// to that large cluster; the others (the bands along sharp edges, between two or more large
+/// clusters) to themselves, which leaves them out of every region. Without this, every noise
+/// island punches a hole with a boundary into its region, and the fillet graph wires lines
+/// to those holes.
+fn island_owners(labels: &[u32], sizes: &[u32], mean: f64, adjacency: &Csr) -> Vec<u32> {
+    let m = sizes.len();
+    let large = |c: u32| sizes[c as usize] as f64 >= mean;
+    let mut parent: Vec<u32> = (0..m as u32).collect();
+    fn find(parent: &mut [u32], mut a: u32) -> u32 {
+        while parent[a as usize] != a {
+            parent[a as usize] = parent[parent[a as usize] as usize];
+            a = parent[a as usize];
+        }
+        a
+    }
+    let mut touches: Vec<(u32, u32)> = Vec::new();
+    for (p, &lp) in labels.iter().enumerate() {
+        if large(lp) || p >= adjacency.num_rows() {
+            continue;
+        }
+        for &q in adjacency.row(p) {
+            let lq = labels[q as usize];
+            if lq == lp {
+                continue;
+            }
+            if large(lq) {
+                touches.push((lp, lq));
+            } else {
+                let (a, b) = (find(&mut parent, lp), find(&mut parent, lq));
+                if a != b {
+                    parent[a.max(b) as usize] = a.min(b);
+                }
+            }
+        }
+    }
+    // Large clusters touched by each group of small clusters.
+    let mut seen: Vec<(u32, u32)> = touches
+        .into_iter()
+        .map(|(s, l)| (find(&mut parent, s), l))
+        .collect();
+    seen.sort_unstable();
+    seen.dedup();
+    let mut only = vec![u32::MAX; m];
+    let mut count = vec![0u32; m];
+    for &(g, l) in &seen {
+        count[g as usize] += 1;
+        only[g as usize] = l;
+    }
+    (0..m as u32)
+        .map(|c| {
+            if large(c) {
+                return c;
+            }
+            let g = find(&mut parent, c) as usize;
+            if count[g] == 1 {
+                only[g]
+            } else {
+                c
+            }
+        })
+        .collect()
 }
 
 /// The region's adjacency in local indices (neighbours outside the region dropped).
@@ -571,7 +647,7 @@ fn candidate(
     ];
     let contrast = (medians[1] - medians[0]) / medians[1].abs().max(f64::MIN_POSITIVE);
     let accepted = split.ratio >= MIN_RATIO
-        && split.right_ratio() >= MIN_RATIO
+        && split.right_ratio() >= MIN_RIGHT_RATIO
         && contrast >= MIN_CONTRAST
         && interiors
             .iter()
