@@ -367,4 +367,10 @@ fn demo_writes_its_results() {
         .as_f64()
         .unwrap();
     assert!(mesh_f1 > 0.95, "mesh F1 {mesh_f1}");
+    // The curve network: the fillet's two border lines, each joined at both ends to the sharp
+    // lines of the block's end faces.
+    let net = &v["curve_network"];
+    assert_eq!(net["smooth_polylines"], 2, "{net}");
+    assert_eq!(net["joined_smooth_ends"], 4, "{net}");
+    assert!(net["sharp_polylines"].as_u64().unwrap() >= 10, "{net}");
 }

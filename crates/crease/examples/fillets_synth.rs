@@ -53,8 +53,8 @@ fn main() {
         );
         for t in &r.thresholds {
             println!(
-                "  {:.3?} tau {:.3} ratio {:.2} b {} {} {} k {} acc {} high {} inner {} border {} noisy {} bands {} {} lines {} loops {}",
-                t.interval, t.split.tau, t.split.ratio, t.split.b1, t.split.b2, t.split.b3, t.split.joined, t.accepted, t.high, t.inner, t.border, t.noisy,
+                "  {:.3?} tau {:.3} ratio {:.2} b {} {} {} k {} contrast {:.2} acc {} high {} inner {} border {} noisy {} bands {} {} lines {} loops {}",
+                t.interval, t.split.tau, t.split.ratio, t.split.b1, t.split.b2, t.split.b3, t.split.joined, t.contrast, t.accepted, t.high, t.inner, t.border, t.noisy,
                 t.band_interiors[0], t.band_interiors[1], t.polylines, t.closed_loops
             );
         }

@@ -66,14 +66,16 @@ pub const MIN_RATIO: f64 = 2.0;
 pub const MIN_RIGHT_RATIO: f64 = 1.5;
 
 /// Smallest relative difference (high − low) / high of the median curvatures on the two
-/// sides of an accepted threshold: patches of one analytic surface (a cylinder's curvature
-/// varies by round-off only) are not split.
-pub const MIN_CONTRAST: f64 = 0.2;
+/// sides of an accepted threshold: patches of one analytic surface are not split (a
+/// cylinder's curvature varies by round-off only; along a cone whose radius halves the two
+/// halves' medians differ by 0.24 to 0.30, measured on sparse samples). Fillet borders have
+/// far more (plane / fillet 1.0, fillet / spherical corner 0.5).
+pub const MIN_CONTRAST: f64 = 0.35;
 
 /// An accepted threshold's bands must each hold a patch interior of at least this many times
 /// the quadric's k points: noise makes curvature blobs about one neighbourhood (k points) wide,
 /// whose interiors stay below that.
-pub const INTERIOR_FACTOR: usize = 2;
+pub const INTERIOR_FACTOR: usize = 3;
 
 /// Valleys of one interval tried, in decreasing ε, before the interval is left unsplit.
 pub const MAX_TRIES: usize = 8;
@@ -149,6 +151,8 @@ pub struct ThresholdReport {
     /// The curvature interval it splits (between the neighbouring accepted thresholds; null
     /// for an open end).
     pub interval: [Option<f64>; 2],
+    /// (high − low) / high of the median curvatures on either side within the interval.
+    pub contrast: f64,
     /// Whether it was used for lines.
     pub accepted: bool,
     /// Points above τ.
@@ -595,6 +599,7 @@ struct Candidate {
     labels: Vec<Label>,
     /// Interiors of the interval's bands below and above τ.
     interiors: [usize; 2],
+    contrast: f64,
     accepted: bool,
     /// The interval split (-∞ / +∞ at the ends of the value range).
     range: [f64; 2],
@@ -646,16 +651,17 @@ fn candidate(
         band_median(values, split.tau, range[1]),
     ];
     let contrast = (medians[1] - medians[0]) / medians[1].abs().max(f64::MIN_POSITIVE);
+    let min_patch = INTERIOR_FACTOR * params.curvature_k;
     let accepted = split.ratio >= MIN_RATIO
         && split.right_ratio() >= MIN_RIGHT_RATIO
+        && split.b1.min(split.b3) >= min_patch as u64
         && contrast >= MIN_CONTRAST
-        && interiors
-            .iter()
-            .all(|&s| s >= INTERIOR_FACTOR * params.curvature_k);
+        && interiors.iter().all(|&s| s >= min_patch);
     Candidate {
         split,
         labels,
         interiors,
+        contrast,
         accepted,
         range,
     }
@@ -844,6 +850,7 @@ fn report(c: &Candidate, net: Option<&LineNetwork>) -> ThresholdReport {
     ThresholdReport {
         split: c.split,
         interval: c.range.map(|x| x.is_finite().then_some(x)),
+        contrast: c.contrast,
         accepted: c.accepted,
         high: c.labels.len() - count(Label::Low),
         inner: count(Label::Inner),
