@@ -20,6 +20,15 @@ use serde::Serialize;
 use crate::geometry::Csr;
 use crate::lines::Segmentation;
 
+/// The neighbours of point `i` (none when the adjacency has no row for it).
+fn row_of(adjacency: &Csr, i: usize) -> &[u32] {
+    if i < adjacency.num_rows() {
+        adjacency.row(i)
+    } else {
+        &[]
+    }
+}
+
 /// The label of a point for one threshold (section 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -56,13 +65,7 @@ pub fn label(values: &[f64], tau: f64, adjacency: &Csr) -> Vec<Label> {
 pub fn label_high(high: &[bool], adjacency: &Csr) -> Vec<Label> {
     let len = high.len();
     let high = |i: usize| high[i];
-    let row = |i: usize| {
-        if i < adjacency.num_rows() {
-            adjacency.row(i)
-        } else {
-            &[]
-        }
-    };
+    let row = |i: usize| row_of(adjacency, i);
     let inner: Vec<bool> = (0..len)
         .into_par_iter()
         .map(|i| high(i) && row(i).iter().all(|&q| high(q as usize)))
@@ -89,13 +92,7 @@ pub fn grow(labels: &[Label], adjacency: &Csr) -> Segmentation {
     let mut out = vec![u32::MAX; n];
     let mut sizes: Vec<u32> = Vec::new();
     let mut queue = VecDeque::new();
-    let row = |i: usize| {
-        if i < adjacency.num_rows() {
-            adjacency.row(i)
-        } else {
-            &[]
-        }
-    };
+    let row = |i: usize| row_of(adjacency, i);
     // Seeds are inner or low points first; border points never seed a cluster.
     for pass in 0..2 {
         for seed in 0..n {
@@ -142,13 +139,7 @@ pub fn grow(labels: &[Label], adjacency: &Csr) -> Segmentation {
 pub fn band_interior(values: &[f64], a: f64, b: f64, adjacency: &Csr) -> usize {
     let n = values.len();
     let within = |i: usize| values[i] > a && values[i] <= b;
-    let row = |i: usize| {
-        if i < adjacency.num_rows() {
-            adjacency.row(i)
-        } else {
-            &[]
-        }
-    };
+    let row = |i: usize| row_of(adjacency, i);
     let interior: Vec<bool> = (0..n)
         .into_par_iter()
         .map(|i| within(i) && row(i).iter().all(|&q| within(q as usize)))

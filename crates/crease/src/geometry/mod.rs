@@ -18,7 +18,7 @@ pub use cleanup::{clean_mesh, CleanupParams, CleanupReport};
 pub use csr::Csr;
 pub use mesh::TriMesh;
 pub use point_cloud::{Point3, PointCloud};
-pub use polyline::chain_segments;
+pub use polyline::{chain_segments, network_counts, NetworkCounts};
 pub use spacing::{average_spacing, average_spacing_with};
 pub use topology::{
     face_area, face_areas, face_normal, face_normals, MeshTopology, OneRing, VertexKind,

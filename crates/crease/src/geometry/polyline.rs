@@ -4,6 +4,39 @@
 
 use super::Csr;
 
+/// Counts of a curve network (vertices, edges, polylines): the shape of its topology.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct NetworkCounts {
+    /// Vertices of degree 1 (open ends).
+    pub endpoints: usize,
+    /// Vertices of degree 3 or more.
+    pub junctions: usize,
+    /// Polylines that are closed loops (first index repeated at the end).
+    pub closed_loops: usize,
+}
+
+/// Endpoints and junctions of the graph (`num_points` vertices, `segments`) and the closed loops
+/// among `polylines`.
+pub fn network_counts(
+    num_points: usize,
+    segments: &[[u32; 2]],
+    polylines: &[Vec<u32>],
+) -> NetworkCounts {
+    let mut deg = vec![0u32; num_points];
+    for e in segments {
+        deg[e[0] as usize] += 1;
+        deg[e[1] as usize] += 1;
+    }
+    NetworkCounts {
+        endpoints: deg.iter().filter(|&&d| d == 1).count(),
+        junctions: deg.iter().filter(|&&d| d >= 3).count(),
+        closed_loops: polylines
+            .iter()
+            .filter(|l| l.len() > 2 && l.first() == l.last())
+            .count(),
+    }
+}
+
 /// Chains `segments` (pairs of point indices below `num_points`) into polylines.
 ///
 /// Output: point-index chains in a deterministic order (chains starting at the lowest

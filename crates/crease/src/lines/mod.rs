@@ -131,29 +131,21 @@ pub struct LineNetwork {
 impl LineNetwork {
     /// Vertices of degree 1.
     pub fn endpoints(&self) -> usize {
-        self.degrees().iter().filter(|&&d| d == 1).count()
+        self.counts().endpoints
     }
 
     /// Vertices of degree 3 or more.
     pub fn junctions(&self) -> usize {
-        self.degrees().iter().filter(|&&d| d >= 3).count()
+        self.counts().junctions
     }
 
     /// Polylines that are closed loops.
     pub fn closed_loops(&self) -> usize {
-        self.polylines
-            .iter()
-            .filter(|l| l.len() > 2 && l.first() == l.last())
-            .count()
+        self.counts().closed_loops
     }
 
-    fn degrees(&self) -> Vec<u32> {
-        let mut deg = vec![0u32; self.vertices.len()];
-        for e in &self.edges {
-            deg[e[0] as usize] += 1;
-            deg[e[1] as usize] += 1;
-        }
-        deg
+    fn counts(&self) -> crate::geometry::NetworkCounts {
+        crate::geometry::network_counts(self.vertices.len(), &self.edges, &self.polylines)
     }
 }
 
