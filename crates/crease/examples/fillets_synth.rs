@@ -29,6 +29,7 @@ fn main() {
     .expect("sample");
     let params = FilletParams {
         smoothing_iterations: iters,
+        coarse_retry: std::env::var("FILLET_RETRY").is_ok(),
         median_iterations: std::env::var("FILLET_MED")
             .ok()
             .and_then(|s| s.parse().ok())

@@ -156,3 +156,29 @@ fn no_smooth_lines_without_fillets() {
         assert_eq!(f.lines.polylines.len(), 0, "{name} noise {noise}");
     }
 }
+
+/// `coarse_retry` (off by default) for noisy scans: at noise 10 % of the spacing the k = 20
+/// curvature finds no valley on the rounded cube; the retry at k = 40 finds the face loops and
+/// the corners. Measured (100k points): 14 closed loops, 32 of 48 curves covered.
+#[test]
+fn coarse_retry_recovers_a_noisy_rounded_cube() {
+    let part = common::noisy_part("rounded-cube", 100_000, 0.1);
+    let params = FilletParams {
+        coarse_retry: true,
+        ..Default::default()
+    };
+    let f = extract_fillets(&part.cloud.positions, &params, false).expect("fillets");
+    let (cover, close) = score(&part, &f);
+    let covered = cover.iter().filter(|&&c| c >= 0.9).count();
+    println!(
+        "noise 10 %, retry: {} polylines, {} closed, covered {covered}/{}, close {close:.3}",
+        f.lines.polylines.len(),
+        f.lines.closed_loops(),
+        cover.len()
+    );
+    assert!(covered >= 24, "{cover:?}");
+    assert!(close >= 0.95, "{close}");
+    assert_eq!(f.lines.endpoints(), 0);
+    assert!(f.lines.closed_loops() >= 6);
+    assert_eq!(f.regions[0].curvature_k, 40);
+}

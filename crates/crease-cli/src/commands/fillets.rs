@@ -68,6 +68,10 @@ pub struct FilletsArgs {
     /// Curvature thresholds given by hand (comma-separated, used in every region).
     #[arg(long, value_delimiter = ',')]
     pub tau: Vec<f64>,
+    /// Noisy scans: examine a region where no threshold is accepted once more with the
+    /// curvature at twice --curvature-k (may split sharp edges the segmentation missed).
+    #[arg(long)]
+    pub coarse_retry: bool,
     /// Leave the cloud's boundary out of the network.
     #[arg(long)]
     pub no_boundary: bool,
@@ -133,6 +137,7 @@ fn params(a: &FilletsArgs) -> anyhow::Result<FilletParams> {
             Search::Full
         },
         thresholds,
+        coarse_retry: a.coarse_retry,
         ..Default::default()
     })
 }
