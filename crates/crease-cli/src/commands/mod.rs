@@ -3,6 +3,7 @@
 mod convert;
 pub mod curvature;
 mod demo;
+pub(crate) mod edges;
 pub(crate) mod eval;
 mod info;
 pub(crate) mod lines;
@@ -36,6 +37,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sharp(a) => sharp::run(g, &a),
         Command::Lines(a) => lines::run(g, &a),
         Command::Eval(a) => eval::run(g, &a),
+        Command::Edges(a) => edges::run(g, &a),
     }
 }
 
