@@ -33,6 +33,11 @@ struct Opts {
     potts: PottsParams,
     scales: Vec<f64>,
     label_degrees: f64,
+    noise: f64,
+    mean_init: bool,
+    iterations: usize,
+    compact: bool,
+    best: bool,
 }
 
 fn parse() -> Opts {
@@ -43,8 +48,17 @@ fn parse() -> Opts {
         potts: d.potts,
         scales: d.tangent.scales.clone(),
         label_degrees: 25.0,
+        noise: 0.005,
+        mean_init: d.tangent.mean_init,
+        iterations: d.tangent.iterations,
+        compact: false,
+        best: false,
     };
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    if let Some(i) = args.iter().position(|a| a == "--compact") {
+        o.compact = true;
+        args.remove(i);
+    }
     let mut i = 0;
     while i + 1 < args.len() {
         let v = &args[i + 1];
@@ -58,6 +72,10 @@ fn parse() -> Opts {
             "--sigma" => o.potts.sigma = f(),
             "--theta-true" => o.potts.theta_true = f().to_radians(),
             "--label-degrees" => o.label_degrees = f(),
+            "--noise" => o.noise = f(),
+            "--best" => o.best = v == "1",
+            "--mean-init" => o.mean_init = v == "1",
+            "--iterations" => o.iterations = v.parse().expect("a count"),
             "--scales" => o.scales = v.split(',').map(|s| s.parse().expect("scale")).collect(),
             a => panic!("unknown option {a}"),
         }
@@ -163,16 +181,30 @@ fn score(o: &Opts, mesh: &TriMesh, truth: &[bool], times: &mut [f64; 2]) -> Row 
         &em,
         &TangentParams {
             scales: o.scales.clone(),
+            mean_init: o.mean_init,
+            iterations: o.iterations,
             ..TangentParams::default()
         },
     )
     .expect("tangent");
     let tan = mean_tangent_angle(&ta);
-    times[0] += t0.elapsed().as_secs_f64();
     let hys = hysteresis_scores(&em, &em.dihedral, d.low_ratio).expect("hysteresis");
     let t = d.threshold_degrees.to_radians();
     let auc_of = |s: &[f64]| roc(s, truth).map(|r| r.auc).unwrap_or(f64::NAN);
     let conf = |l: &[bool]| Confusion::from_labels(l, truth).expect("lengths");
+    if o.best {
+        for (name, sc) in [("dihedral", &em.dihedral), ("tangent", &tan)] {
+            let mut best = (0.0, 0.0);
+            for deg in 1..90 {
+                let f = conf(&threshold(sc, (deg as f64).to_radians())).metrics().f1;
+                if f > best.0 {
+                    best = (f, deg as f64);
+                }
+            }
+            eprint!(" [{name} best F1 {:.3} at {} deg]", best.0, best.1);
+        }
+    }
+    times[0] += t0.elapsed().as_secs_f64();
     let pairs = EdgePairs::new(&em);
     let t1 = Instant::now();
     let sweep = |angles: &[f64]| -> (f64, Confusion) {
@@ -244,7 +276,7 @@ fn main() {
         let mut tot = [Confusion::default(); 5];
         for c in &cs {
             let mesh = if noisy {
-                add_noise(&c.mesh, 0.005, 7).expect("noise")
+                add_noise(&c.mesh, o.noise, 7).expect("noise")
             } else {
                 c.mesh.clone()
             };
@@ -253,12 +285,16 @@ fn main() {
             let r = score(&o, &mesh, &c.truth, &mut times);
             for k in 0..5 {
                 let m = r.conf[k].metrics();
-                print!(
-                    "{:>8.2} ({:.2}/{:>5.0})",
-                    100.0 * r.auc[k],
-                    m.f1,
-                    1e4 * (1.0 - m.specificity)
-                );
+                if o.compact {
+                    print!("{:>8.2} {:.2}", 100.0 * r.auc[k], m.f1);
+                } else {
+                    print!(
+                        "{:>8.2} ({:.2}/{:>5.0})",
+                        100.0 * r.auc[k],
+                        m.f1,
+                        1e4 * (1.0 - m.specificity)
+                    );
+                }
                 tot[k] = tot[k].merged(&r.conf[k]);
             }
             println!();

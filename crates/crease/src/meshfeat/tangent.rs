@@ -21,6 +21,24 @@
 //!   have opposite normals and are rejected by the 23° test anyway.
 //! - Rejected faces accepted in the second pass also update the normal.
 //!
+//! **Initial normals (crease's change, on by default).** The paper starts each region from the
+//! normal of the edge's own face. At the noise of section 6.1 (Gaussian, 0.5 % of the bounding
+//! box's largest side, i.e. about 0.3 edge lengths on a 60-edges-per-side mesh) single face
+//! normals are off by 20–30°, so the 23° test keeps mostly the faces that agree with the noisy
+//! seed and θ̂ʳ stays about as noisy as the dihedral angle. Starting instead from the
+//! area-weighted mean normal of all the faces of each side in the sphere (then growing exactly
+//! as the paper does) lifts the per-edge AUC of θ̂ʳ (mean of r = 4, 7, 10 %) on the noisy
+//! synthetic cube from 90.6 % to 98.7 % and on noisy fandisk from 85.7 % to 93.9 %
+//! (`examples/meshfeat_table2.rs`). [`TangentParams::mean_init`] = false gives the paper's
+//! seeds; [`TangentParams::iterations`] > 1 regrows from the previous normals (measured: no
+//! gain).
+//!
+//! **Smallest sphere (crease's addition).** r is a fraction of the bounding box's smallest
+//! side (section 4); on a fine or flat mesh r = 4 % can be shorter than an edge, and the sphere
+//! then holds no face but the edge's own two, so θ̂ʳ is the dihedral angle with all its noise
+//! (a noisy 60 × 60 grid: 512 false sharp edges at 65° instead of 0). Radii are therefore at
+//! least [`TangentParams::min_edge_lengths`] = 2 mean edge lengths.
+//!
 //! **Sharing work across scales and bounded cost (crease's addition).** The faces in a sphere
 //! grow as r² / (mean face area): at r = 28 % of a part on a 1M-edge mesh that is ~10⁵ faces per
 //! edge. The area-weighted mean normal is a ratio of sums over the faces, so it is estimated
@@ -52,6 +70,16 @@ pub struct TangentParams {
     /// subset of the faces (see the module documentation); `None` = always every face (exact,
     /// cost grows as r²).
     pub max_faces: Option<usize>,
+    /// Initial region normals: `false` = the normals of the edge's two faces (the paper);
+    /// `true` (default) = the area-weighted mean normal of all the faces of each side in the
+    /// sphere (see the module documentation).
+    pub mean_init: bool,
+    /// Number of growings: each one after the first starts from the previous one's normals.
+    pub iterations: usize,
+    /// Smallest radius, in mean edge lengths of the mesh (default 2; 0 = none): a sphere
+    /// smaller than the faces holds only the edge's own two faces, and θ̂ʳ degenerates to the
+    /// dihedral angle (see the module documentation).
+    pub min_edge_lengths: f64,
 }
 
 /// The scales of section 4 for the tangent-plane angle: 4, 7, ..., 28 % of the reference length.
@@ -63,6 +91,9 @@ impl Default for TangentParams {
             scales: PAPER_SCALES.to_vec(),
             accept_degrees: 23.0,
             max_faces: Some(384),
+            mean_init: true,
+            iterations: 1,
+            min_edge_lengths: 2.0,
         }
     }
 }
@@ -253,7 +284,7 @@ pub fn tangent_angles(em: &EdgeMesh, params: &TangentParams) -> Result<TangentAn
     let radii: Vec<f64> = params
         .scales
         .iter()
-        .map(|s| s * em.reference_length)
+        .map(|s| (s * em.reference_length).max(params.min_edge_lengths * em.mean_edge_length))
         .collect();
 
     // Level per scale from the expected number of faces in a disc of radius r.
@@ -302,7 +333,7 @@ pub fn tangent_angles(em: &EdgeMesh, params: &TangentParams) -> Result<TangentAn
         .par_chunks_mut(ns)
         .enumerate()
         .for_each_init(Scratch::default, |scratch, (e, out)| {
-            edge_angles(em, e, &radii, &groups, cos_accept, scratch, out);
+            edge_angles(em, e, &radii, &groups, cos_accept, params, scratch, out);
         });
     Ok(TangentAngles {
         radii,
@@ -318,6 +349,7 @@ fn edge_angles(
     radii: &[f64],
     groups: &[Group],
     cos_accept: f64,
+    params: &TangentParams,
     scratch: &mut Scratch,
     out: &mut [f64],
 ) {
@@ -374,35 +406,67 @@ fn edge_angles(
         cand.sort_unstable_by(|x, y| x.0.abs().total_cmp(&y.0.abs()).then(x.1.cmp(&y.1)));
         for &si in &g.scales {
             let r2 = radii[si] * radii[si];
-            out[si] = grow(
-                em,
-                fa,
-                fb,
-                &scratch.cand,
-                r2,
-                cos_accept,
-                &mut scratch.rejected,
-            );
+            let mut init = [na, nb];
+            if params.mean_init {
+                let mut sum = [[0.0; 3]; 2];
+                for &(sd, f, d2) in scratch.cand.iter() {
+                    if d2 <= r2 {
+                        let k = usize::from(sd >= 0.0);
+                        sum[k] = vec3::add(
+                            sum[k],
+                            vec3::scale(em.normals[f as usize], em.areas[f as usize]),
+                        );
+                    }
+                }
+                for k in 0..2 {
+                    if let Some(u) = vec3::normalize(sum[k]) {
+                        init[k] = u;
+                    }
+                }
+            }
+            for it in 0..params.iterations.max(1) {
+                init = grow(
+                    em,
+                    fa,
+                    fb,
+                    init,
+                    it == 0,
+                    &scratch.cand,
+                    r2,
+                    cos_accept,
+                    &mut scratch.rejected,
+                );
+            }
+            out[si] = vec3::angle(init[0], init[1]);
         }
     }
 }
 
 /// The region growing of section 3.2 over the candidates (sorted by distance to the
-/// separating plane) whose squared distance to the midpoint is at most `r2`.
+/// separating plane) whose squared distance to the midpoint is at most `r2`, starting from the
+/// normals `init`, with the edge's two faces in their regions from the start if `seeds`.
+/// (Testing the two faces like the other candidates instead, with the mean initialisation,
+/// was measured: 17 instead of 147 false edges on the 0.5 %-noise grid, but the mean AUC of
+/// Table 2 fell from 87.5 % to 85.0 % on the noisy meshes and from 97.2 % to 94.7 % on the
+/// clean ones.)
+#[allow(clippy::too_many_arguments)]
 fn grow(
     em: &EdgeMesh,
     fa: usize,
     fb: usize,
+    init: [Point3; 2],
+    seeds: bool,
     cand: &[(f64, u32, f64)],
     r2: f64,
     cos_accept: f64,
     rejected: &mut Vec<u32>,
-) -> f64 {
+) -> [Point3; 2] {
+    let w = if seeds { 1.0 } else { 0.0 };
     let mut sum = [
-        vec3::scale(em.normals[fa], em.areas[fa]),
-        vec3::scale(em.normals[fb], em.areas[fb]),
+        vec3::scale(em.normals[fa], w * em.areas[fa]),
+        vec3::scale(em.normals[fb], w * em.areas[fb]),
     ];
-    let mut normal = [em.normals[fa], em.normals[fb]];
+    let mut normal = init;
     rejected.clear();
     let try_add = |side: usize, f: usize, sum: &mut [Point3; 2], normal: &mut [Point3; 2]| {
         let n = em.normals[f];
@@ -430,5 +494,5 @@ fn grow(
         let f = (tagged & !(1 << 31)) as usize;
         try_add(side, f, &mut sum, &mut normal);
     }
-    vec3::angle(normal[0], normal[1])
+    normal
 }
