@@ -49,8 +49,8 @@ fn tangent_angle_is_exact_on_a_clean_cube_and_per_scale() {
     };
     let t = tangent_angles(&em, &paper).unwrap();
     assert_eq!(t.num_scales(), 9);
-    for e in 0..em.num_edges() {
-        let want = if truth[e] { 90.0 } else { 0.0 };
+    for (e, &is_sharp) in truth.iter().enumerate() {
+        let want = if is_sharp { 90.0 } else { 0.0 };
         for (s, a) in t.edge(e).iter().enumerate() {
             // The cube's faces are exactly planar: the regions are exactly the two faces of
             // the edge's planes (other planes are rejected at 90 degrees > 23).

@@ -380,6 +380,7 @@ pub fn tangent_angles(em: &EdgeMesh, params: &TangentParams) -> Result<TangentAn
 }
 
 /// Fills `out` (one angle per scale) for edge `e`; leaves π for edges without two faces.
+#[allow(clippy::too_many_arguments)]
 fn edge_angles(
     em: &EdgeMesh,
     e: usize,
