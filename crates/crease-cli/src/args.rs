@@ -70,6 +70,9 @@ pub enum Command {
     /// Score a labelled output against ground truth: precision, recall, F1, MCC, IoU, tolerant
     /// scores, ROC and AUC.
     Eval(crate::commands::eval::EvalArgs),
+    /// Feature edges of a triangle mesh that survive noise (tangent-plane angle, Potts energy
+    /// minimised by a graph cut; dihedral and hysteresis thresholding as baselines).
+    Edges(crate::commands::edges::EdgesArgs),
     /// Run every capability on a built-in synthetic part; no input files needed.
     Demo {
         /// Folder to write the results into.

@@ -19,6 +19,7 @@ pub mod geometry;
 pub mod graphcut;
 pub mod io;
 pub mod lines;
+pub mod meshfeat;
 pub mod render;
 pub mod sharp;
 pub mod spatial;

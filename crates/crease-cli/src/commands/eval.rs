@@ -53,9 +53,18 @@ pub struct EvalArgs {
     /// Write the full ROC curve as CSV (threshold,fpr,tpr; one row per distinct score).
     #[arg(long, value_name = "OUT.csv")]
     pub roc: Option<PathBuf>,
+    /// Score mesh edges instead of points: the labels and score are properties of PRED's
+    /// `edge` element (as `crease edges` writes); GT is an ABC features .yml (its `sharp`
+    /// curves' edges) or a file with an `edge` element whose --gt-label property (default
+    /// gt_sharp or sharp) marks the true feature edges. Edges are matched by vertex pair.
+    #[arg(long, conflicts_with = "gt_colors")]
+    pub edges: bool,
 }
 
 pub fn run(g: &Global, a: &EvalArgs) -> anyhow::Result<()> {
+    if a.edges {
+        return run_edges(g, a);
+    }
     if let Some(t) = a.tolerance {
         if !(t.is_finite() && t >= 0.0) {
             return Err(usage(format!(
@@ -140,6 +149,136 @@ pub fn run(g: &Global, a: &EvalArgs) -> anyhow::Result<()> {
             "{}",
             text_report(a, &truth.source, &a.label, score_name, &report)
         );
+    }
+    Ok(())
+}
+
+/// `crease eval --edges`: per-edge scores (see [`EvalArgs::edges`]).
+fn run_edges(g: &Global, a: &EvalArgs) -> anyhow::Result<()> {
+    use std::collections::HashSet;
+    if let Some(roc) = &a.roc {
+        crate::ui::ensure_not_input(roc, &[&a.pred, &a.gt])?;
+    }
+    let (pred, _) = super::load(g, &a.pred)?;
+    if pred.edges.is_empty() {
+        anyhow::bail!(
+            "{}: no edge element; --edges scores the edges written by `crease edges`",
+            a.pred.display()
+        );
+    }
+    let ext =
+        a.gt.extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+    let (true_pairs, source) = if matches!(ext.as_deref(), Some("yml" | "yaml")) {
+        let pairs = crease::meshfeat::read_abc_sharp_edges(&a.gt)?;
+        (pairs, "ABC sharp curves".to_string())
+    } else {
+        let (gt, _) = super::load(g, &a.gt)?;
+        if !same_path(&a.pred, &a.gt) {
+            check_same_points(&pred.points.positions, &a.pred, &gt.points.positions, &a.gt)?;
+        }
+        let names: Vec<String> = match &a.gt_label {
+            Some(n) => vec![n.clone()],
+            None => vec!["gt_sharp".into(), "sharp".into()],
+        };
+        let Some(attr) = names.iter().find_map(|n| gt.edge_attributes.get(n)) else {
+            anyhow::bail!(
+                "{}: no edge property {} holding the true feature edges",
+                a.gt.display(),
+                names.join(" or ")
+            );
+        };
+        let pairs = gt
+            .edges
+            .iter()
+            .zip(&attr.values)
+            .filter(|(_, &v)| v > 0.0)
+            .map(|(&e, _)| e)
+            .collect();
+        (pairs, format!("edge property {}", attr.name))
+    };
+    let key = |e: [u32; 2]| (e[0].min(e[1]), e[0].max(e[1]));
+    let set: HashSet<(u32, u32)> = true_pairs.iter().map(|&e| key(e)).collect();
+    let truth: Vec<bool> = pred.edges.iter().map(|&e| set.contains(&key(e))).collect();
+    let found = truth.iter().filter(|&&t| t).count();
+    let n_pts = pred.points.len();
+    if let Some(e) = true_pairs
+        .iter()
+        .find(|e| e[0] as usize >= n_pts || e[1] as usize >= n_pts)
+    {
+        anyhow::bail!(
+            "{}: true edge ({}, {}) refers to a vertex beyond the {n_pts} of {}",
+            a.gt.display(),
+            e[0],
+            e[1],
+            a.pred.display()
+        );
+    }
+    let label_attr = pred
+        .edge_attributes
+        .get(&a.label)
+        .ok_or_else(|| anyhow::anyhow!("{}: no edge property {:?}", a.pred.display(), a.label))?;
+    let predicted: Vec<bool> = label_attr.values.iter().map(|&v| v > 0.0).collect();
+    let score_name = match &a.score {
+        Some(s) => Some(s.as_str()),
+        None => pred
+            .edge_attributes
+            .get(DEFAULT_SCORE)
+            .map(|_| DEFAULT_SCORE),
+    };
+    let scores = match score_name {
+        Some(n) => Some(
+            pred.edge_attributes
+                .get(n)
+                .ok_or_else(|| anyhow::anyhow!("{}: no edge property {n:?}", a.pred.display()))?
+                .values
+                .clone(),
+        ),
+        None => None,
+    };
+    let p = &pred.points.positions;
+    let mids: Vec<[f64; 3]> = pred
+        .edges
+        .iter()
+        .map(|&[u, v]| {
+            let (x, y) = (p[u as usize], p[v as usize]);
+            [0, 1, 2].map(|k| 0.5 * (x[k] + y[k]))
+        })
+        .collect();
+    let report = evaluate(
+        &Labels {
+            predicted: &predicted,
+            truth: &truth,
+            scores: scores.as_deref(),
+            positions: Some(&mids),
+            classes: None,
+        },
+        &EvalParams {
+            tolerance: a.tolerance,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| anyhow::anyhow!("{} vs {}: {e}", a.pred.display(), a.gt.display()))?;
+    if let (Some(path), Some(roc)) = (&a.roc, &report.roc) {
+        write_roc(path, &roc.full)?;
+    }
+    let missing = set.len() - found;
+    if g.json {
+        let mut v = serde_json::to_value(&report)?;
+        v["prediction"] = serde_json::json!({
+            "file": a.pred, "label": a.label, "score": score_name, "items": "edges",
+        });
+        v["ground_truth"] = serde_json::json!({
+            "file": a.gt, "source": source, "true_edges_not_in_prediction": missing,
+        });
+        v["roc_csv"] = serde_json::json!(a.roc);
+        crate::ui::print_json(&v)?;
+    } else {
+        print!("{}", text_report(a, &source, &a.label, score_name, &report));
+        if missing > 0 {
+            println!("note: {missing} true edges are not edges of the prediction");
+        }
     }
     Ok(())
 }

@@ -3,6 +3,7 @@
 mod convert;
 pub mod curvature;
 mod demo;
+pub(crate) mod edges;
 pub(crate) mod eval;
 pub(crate) mod fillets;
 mod info;
@@ -39,6 +40,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Eval(a) => eval::run(g, &a),
         Command::Fillets(a) => fillets::run(g, &a, false),
         Command::Network(a) => fillets::run(g, &a, true),
+        Command::Edges(a) => edges::run(g, &a),
     }
 }
 

@@ -1,0 +1,556 @@
+//! The estimator of the angle between tangent-plane normals at a mesh edge, at scale r
+//! (vidal et al. 2011, section 3).
+//!
+//! For an edge e with faces f_L, f_R and midpoint m, the *separating plane* contains the edge
+//! and the bisector of the two face normals (its normal is `d × (n_L + n_R)`, d the edge
+//! direction, oriented towards f_R). Two regions start as {f_L} and {f_R} with normals n_L, n_R.
+//! The faces whose barycentre lies in the sphere of radius r around m are visited by increasing
+//! distance of the barycentre to the separating plane (a priority order, the distance rounded
+//! to f32; ties in a fixed order of the faces); a
+//! face on the positive side (distance ≥ 0) is a candidate for the right region, one on the
+//! strictly negative side for the left region. A candidate whose normal is within 23° of its
+//! region's current normal is accepted and the region normal becomes the area-weighted mean of
+//! its faces' normals; otherwise it is rejected. When all faces are visited, the rejected ones
+//! are tested again, in the same order, against the final normals (section 3.2, "a second
+//! pass"). θ̂ʳ_e is the angle between the two region normals. Boundary and non-manifold
+//! edges get π (section 2).
+//!
+//! **Where the paper is silent (choices made here).**
+//! - "Triangles within the sphere": the barycentre is within r of the midpoint. Faces are
+//!   found by Euclidean search, not by walking the mesh: the paper's growing is explicitly not
+//!   connected, and faces of a nearby but unconnected sheet (the other side of a thin wall)
+//!   have opposite normals and are rejected by the 23° test anyway.
+//! - Rejected faces accepted in the second pass also update the normal.
+//!
+//! **Initial normals (crease's change, on by default).** The paper starts each region from the
+//! normal of the edge's own face. At the noise of section 6.1 (Gaussian, 0.5 % of the bounding
+//! box's largest side, i.e. about 0.3 edge lengths on a 60-edges-per-side mesh) single face
+//! normals are off by 20–30°, so the 23° test keeps mostly the faces that agree with the noisy
+//! seed and θ̂ʳ stays about as noisy as the dihedral angle. Starting instead from the
+//! area-weighted mean normal of all the faces of each side in the sphere (then growing exactly
+//! as the paper does) lifts the per-edge AUC of θ̂ʳ (mean of r = 4, 7, 10 %) on the noisy
+//! synthetic cube from 90.6 % to 98.7 % and on noisy fandisk from 85.7 % to 93.9 %, and the
+//! mean over the 14 noisy meshes of `examples/meshfeat_table2.rs` from 80.5 % to 89.2 %
+//! (measured without the smallest radius below; with it: 98.7 %, 93.8 %, 87.5 %). The price
+//! is localisation: beside a crease the mean mixes both surfaces, so lines come out a few
+//! edges wide (F1 0.5–0.6 on the noisy synthetic parts, limited by precision) and on clean
+//! meshes the paper's seeds are exact where the mean initialisation is not (clean mean AUC
+//! 97.2 % against 100 % for the dihedral angle). [`TangentParams::mean_init`] = false gives the paper's
+//! seeds; [`TangentParams::iterations`] > 1 regrows from the previous normals (measured: no
+//! gain).
+//!
+//! **Smallest sphere (crease's addition).** r is a fraction of the bounding box's smallest
+//! side (section 4); on a fine or flat mesh r = 4 % can be shorter than an edge, and the sphere
+//! then holds no face but the edge's own two, so θ̂ʳ is the dihedral angle with all its noise
+//! (a noisy 60 × 60 grid: 512 false sharp edges at 65° instead of 0). Radii are therefore at
+//! least [`TangentParams::min_edge_lengths`] = 2 mean edge lengths.
+//!
+//! **Sharing work across scales and bounded cost (crease's addition).** The faces in a sphere
+//! grow as r² / (mean face area): at r = 28 % of a part on a 1M-edge mesh that is ~10⁵ faces per
+//! edge. The area-weighted mean normal is a ratio of sums over the faces, so it is estimated
+//! without bias from a uniform random subset of the faces. Every face gets a fixed
+//! pseudo-random level (the number of leading zero bits of a hash of its id): level ≥ l keeps
+//! a fraction 2⁻ˡ of the faces, the same subset for every edge. Each scale uses the finest
+//! level at which a sphere holds at most [`TangentParams::max_faces`] faces on average
+//! (a flat disc of radius r), so the estimate is exact (level 0) whenever the sphere is small
+//! and the cost per edge and scale is bounded otherwise. Scales that fall on the same level are
+//! gathered once at the largest of them and sorted once; the smaller scales read the same
+//! order filtered by distance. The per-edge computation is independent of every other edge,
+//! so the result does not depend on the thread count. Measured (release, 2 cores shared with
+//! other jobs, load ≈ 5) on a noisy fillet-chamfer-cone mesh, default 3 scales: 100k edges
+//! 2.1 s, 1M edges 16 s (budget 384: 66 s; the Table 2 AUCs are the same with 128 and 384);
+//! the 9 scales of section 4 at 1M edges: 50 s.
+
+use rayon::prelude::*;
+
+use super::EdgeMesh;
+use crate::geometry::{vec3, Point3};
+use crate::{Error, Result};
+
+/// Parameters of [`tangent_angles`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TangentParams {
+    /// The scales r as fractions of [`EdgeMesh::reference_length`] (section 4: 0.04, 0.07, ...,
+    /// 0.28).
+    pub scales: Vec<f64>,
+    /// The acceptance angle of a face into a region, degrees (section 6.3: 23).
+    pub accept_degrees: f64,
+    /// Average number of faces a sphere may hold before the scale switches to a coarser random
+    /// subset of the faces (see the module documentation; default 128); `None` = always every
+    /// face (exact, cost grows as r²).
+    pub max_faces: Option<usize>,
+    /// Initial region normals: `false` = the normals of the edge's two faces (the paper);
+    /// `true` (default) = the area-weighted mean normal of all the faces of each side in the
+    /// sphere (see the module documentation).
+    pub mean_init: bool,
+    /// Number of growings: each one after the first starts from the previous one's normals.
+    pub iterations: usize,
+    /// Smallest radius, in mean edge lengths of the mesh (default 2; 0 = none): a sphere
+    /// smaller than the faces holds only the edge's own two faces, and θ̂ʳ degenerates to the
+    /// dihedral angle (see the module documentation).
+    pub min_edge_lengths: f64,
+}
+
+/// The scales of section 4 for the tangent-plane angle: 4, 7, ..., 28 % of the reference length.
+pub const PAPER_SCALES: [f64; 9] = [0.04, 0.07, 0.10, 0.13, 0.16, 0.19, 0.22, 0.25, 0.28];
+
+impl Default for TangentParams {
+    fn default() -> Self {
+        TangentParams {
+            scales: PAPER_SCALES.to_vec(),
+            accept_degrees: 23.0,
+            max_faces: Some(128),
+            mean_init: true,
+            iterations: 1,
+            min_edge_lengths: 2.0,
+        }
+    }
+}
+
+/// θ̂ʳ_e for every edge and scale.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TangentAngles {
+    /// The scales in mesh units (radius of the sphere), in the order of the parameters.
+    pub radii: Vec<f64>,
+    /// The subset level used for each scale (0 = every face).
+    pub levels: Vec<u32>,
+    /// Angles in radians in [0, π], row-major: `angles[e * radii.len() + s]`.
+    pub angles: Vec<f64>,
+}
+
+impl TangentAngles {
+    /// Number of scales.
+    pub fn num_scales(&self) -> usize {
+        self.radii.len()
+    }
+
+    /// The angles of scale `s` for every edge.
+    pub fn scale(&self, s: usize) -> Vec<f64> {
+        let k = self.radii.len();
+        self.angles
+            .iter()
+            .skip(s)
+            .step_by(k.max(1))
+            .copied()
+            .collect()
+    }
+
+    /// The angles of edge `e`, one per scale.
+    pub fn edge(&self, e: usize) -> &[f64] {
+        let k = self.radii.len();
+        &self.angles[e * k..(e + 1) * k]
+    }
+}
+
+/// One face in a [`FaceGrid`]: what the growing reads, stored contiguously in cell order so
+/// that a sphere query touches consecutive memory (on a 1M-edge mesh, reading the faces
+/// through their ids instead cost three times as much, in cache misses).
+#[derive(Clone, Copy)]
+struct Item {
+    c: Point3,
+    n: Point3,
+    area: f64,
+    face: u32,
+}
+
+/// A uniform grid over the barycentres of one subset of the faces.
+struct FaceGrid {
+    origin: Point3,
+    inv_cell: f64,
+    dims: [usize; 3],
+    offsets: Vec<u32>,
+    items: Vec<Item>,
+}
+
+/// A face in the sphere of an edge: signed distance to the separating plane, squared distance
+/// to the midpoint, normal, area.
+#[derive(Clone, Copy)]
+struct Cand {
+    sd: f64,
+    d2: f64,
+    n: Point3,
+    area: f64,
+}
+
+impl FaceGrid {
+    fn new(em: &EdgeMesh, faces: Vec<u32>, cell: f64) -> FaceGrid {
+        let centroids = &em.centroids;
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for &f in &faces {
+            let c = centroids[f as usize];
+            for k in 0..3 {
+                lo[k] = lo[k].min(c[k]);
+                hi[k] = hi[k].max(c[k]);
+            }
+        }
+        if faces.is_empty() {
+            lo = [0.0; 3];
+            hi = [0.0; 3];
+        }
+        // Keep the number of cells within a few times the number of faces.
+        let mut cell = cell.max(1e-300);
+        let max_cells = (4 * faces.len()).max(64) as f64;
+        loop {
+            let n: f64 = (0..3)
+                .map(|k| ((hi[k] - lo[k]) / cell).floor() + 1.0)
+                .product();
+            if n <= max_cells {
+                break;
+            }
+            cell *= 1.5;
+        }
+        let dims = [0, 1, 2].map(|k| ((hi[k] - lo[k]) / cell).floor() as usize + 1);
+        let inv_cell = 1.0 / cell;
+        let key = |c: Point3| -> usize {
+            let i = [0, 1, 2].map(|k| (((c[k] - lo[k]) * inv_cell) as usize).min(dims[k] - 1));
+            (i[2] * dims[1] + i[1]) * dims[0] + i[0]
+        };
+        let ncell = dims[0] * dims[1] * dims[2];
+        let mut keyed: Vec<(u32, u32)> = faces
+            .par_iter()
+            .map(|&f| (key(centroids[f as usize]) as u32, f))
+            .collect();
+        keyed.par_sort_unstable();
+        let mut offsets = vec![0u32; ncell + 1];
+        for &(k, _) in &keyed {
+            offsets[k as usize + 1] += 1;
+        }
+        for i in 0..ncell {
+            offsets[i + 1] += offsets[i];
+        }
+        FaceGrid {
+            origin: lo,
+            inv_cell,
+            dims,
+            offsets,
+            items: keyed
+                .into_iter()
+                .map(|(_, f)| Item {
+                    c: centroids[f as usize],
+                    n: em.normals[f as usize],
+                    area: em.areas[f as usize],
+                    face: f,
+                })
+                .collect(),
+        }
+    }
+
+    /// Calls `f` for every face of the grid whose barycentre is within `r` of `q`.
+    fn for_each_within(&self, q: Point3, r: f64, mut f: impl FnMut(&Item, f64)) {
+        let r2 = r * r;
+        let cell_range = |k: usize| {
+            let a = ((q[k] - r - self.origin[k]) * self.inv_cell).floor();
+            let b = ((q[k] + r - self.origin[k]) * self.inv_cell).floor();
+            let last = self.dims[k] as f64 - 1.0;
+            if b < 0.0 || a > last {
+                None
+            } else {
+                Some((a.max(0.0) as usize, b.min(last) as usize))
+            }
+        };
+        let (Some(x), Some(y), Some(z)) = (cell_range(0), cell_range(1), cell_range(2)) else {
+            return;
+        };
+        for iz in z.0..=z.1 {
+            for iy in y.0..=y.1 {
+                let row = (iz * self.dims[1] + iy) * self.dims[0];
+                let s = self.offsets[row + x.0] as usize;
+                let e = self.offsets[row + x.1 + 1] as usize;
+                for it in &self.items[s..e] {
+                    let d2 = vec3::dist2(it.c, q);
+                    if d2 <= r2 {
+                        f(it, d2);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The level of a face: leading zero bits of a SplitMix64 hash of its id (level ≥ l holds a
+/// fraction 2⁻ˡ of the faces, independently of the mesh's face order statistics).
+fn face_level(f: u32) -> u32 {
+    let mut z = u64::from(f).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    z.leading_zeros()
+}
+
+/// One group of scales sharing a face subset: the scale indices (ascending radius) and grid.
+struct Group {
+    scales: Vec<usize>,
+    grid: FaceGrid,
+}
+
+/// Per-thread buffers.
+#[derive(Default)]
+struct Scratch {
+    cand: Vec<Cand>,
+    sorted: Vec<Cand>,
+    keys: Vec<u64>,
+    rejected: Vec<u32>,
+}
+
+/// θ̂ʳ_e (section 3) for every edge of `em` at every scale of `params`, in parallel over the
+/// edges.
+///
+/// Errors: no scale, a scale not positive and finite, an acceptance angle outside (0, 180).
+pub fn tangent_angles(em: &EdgeMesh, params: &TangentParams) -> Result<TangentAngles> {
+    if params.scales.is_empty() {
+        return Err(Error::InvalidArgument(
+            "tangent-plane angles: at least one scale is needed".into(),
+        ));
+    }
+    if let Some(s) = params.scales.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+        return Err(Error::InvalidArgument(format!(
+            "tangent-plane angles: scales must be positive, got {s}"
+        )));
+    }
+    if !(params.accept_degrees > 0.0 && params.accept_degrees < 180.0) {
+        return Err(Error::InvalidArgument(format!(
+            "tangent-plane angles: the acceptance angle must be in (0, 180) degrees, got {}",
+            params.accept_degrees
+        )));
+    }
+    if params.max_faces == Some(0) {
+        return Err(Error::InvalidArgument(
+            "tangent-plane angles: max_faces must be positive".into(),
+        ));
+    }
+    let topo = &em.topo;
+    let nf = topo.num_faces();
+    let ne = topo.num_edges();
+    let ns = params.scales.len();
+    let radii: Vec<f64> = params
+        .scales
+        .iter()
+        .map(|s| (s * em.reference_length).max(params.min_edge_lengths * em.mean_edge_length))
+        .collect();
+
+    // Level per scale from the expected number of faces in a disc of radius r.
+    let total_area: f64 = em.areas.iter().sum();
+    let mean_area = if nf > 0 { total_area / nf as f64 } else { 0.0 };
+    let face_levels: Vec<u32> = (0..nf as u32).into_par_iter().map(face_level).collect();
+    let max_level = 40u32;
+    let levels: Vec<u32> = radii
+        .iter()
+        .map(|&r| match params.max_faces {
+            None => 0,
+            Some(budget) => {
+                if mean_area <= 0.0 {
+                    return 0;
+                }
+                let expected = std::f64::consts::PI * r * r / mean_area;
+                let mut l = 0;
+                while l < max_level && expected / f64::powi(2.0, l as i32) > budget as f64 {
+                    l += 1;
+                }
+                l
+            }
+        })
+        .collect();
+
+    // Group the scales by level; each group gets a grid over its subset.
+    let mut order: Vec<usize> = (0..ns).collect();
+    order.sort_by(|&a, &b| radii[a].total_cmp(&radii[b]).then(a.cmp(&b)));
+    let mut groups: Vec<Group> = Vec::new();
+    let mut distinct: Vec<u32> = levels.clone();
+    distinct.sort_unstable();
+    distinct.dedup();
+    for &l in &distinct {
+        let scales: Vec<usize> = order.iter().copied().filter(|&s| levels[s] == l).collect();
+        let faces: Vec<u32> = (0..nf as u32)
+            .filter(|&f| face_levels[f as usize] >= l && em.areas[f as usize] > 0.0)
+            .collect();
+        let rmax = scales.iter().map(|&s| radii[s]).fold(0.0, f64::max);
+        let grid = FaceGrid::new(em, faces, rmax / 2.0);
+        groups.push(Group { scales, grid });
+    }
+
+    let cos_accept = params.accept_degrees.to_radians().cos();
+    let mut angles = vec![std::f64::consts::PI; ne * ns];
+    angles
+        .par_chunks_mut(ns)
+        .enumerate()
+        .for_each_init(Scratch::default, |scratch, (e, out)| {
+            edge_angles(em, e, &radii, &groups, cos_accept, params, scratch, out);
+        });
+    Ok(TangentAngles {
+        radii,
+        levels,
+        angles,
+    })
+}
+
+/// Fills `out` (one angle per scale) for edge `e`; leaves π for edges without two faces.
+#[allow(clippy::too_many_arguments)]
+fn edge_angles(
+    em: &EdgeMesh,
+    e: usize,
+    radii: &[f64],
+    groups: &[Group],
+    cos_accept: f64,
+    params: &TangentParams,
+    scratch: &mut Scratch,
+    out: &mut [f64],
+) {
+    let faces = em.topo.edge_faces(e);
+    if faces.len() != 2 {
+        return;
+    }
+    let (fa, fb) = (faces[0] as usize, faces[1] as usize);
+    let (na, nb) = (em.normals[fa], em.normals[fb]);
+    if em.areas[fa] <= 0.0 || em.areas[fb] <= 0.0 {
+        return;
+    }
+    let [v0, v1] = em.topo.edges()[e];
+    let p = em.mesh.positions();
+    let (a, b) = (p[v0 as usize], p[v1 as usize]);
+    let m = vec3::scale(vec3::add(a, b), 0.5);
+    let d = vec3::sub(b, a);
+    // Separating plane normal: d × (n_a + n_b), oriented so that face b is on the positive
+    // (right) side; falls back on the barycentre difference when the faces fold back.
+    let toward_b = vec3::sub(em.centroids[fb], em.centroids[fa]);
+    let s = vec3::normalize(vec3::cross(d, vec3::add(na, nb)))
+        .filter(|s| vec3::dot(*s, toward_b).abs() > 1e-12 * vec3::norm(toward_b))
+        .or_else(|| {
+            let dd = vec3::dot(d, d);
+            let k = if dd > 0.0 {
+                vec3::dot(toward_b, d) / dd
+            } else {
+                0.0
+            };
+            vec3::normalize(vec3::sub(toward_b, vec3::scale(d, k)))
+        });
+    let Some(mut s) = s else {
+        out.fill(vec3::angle(na, nb));
+        return;
+    };
+    if vec3::dot(s, toward_b) < 0.0 {
+        s = vec3::scale(s, -1.0);
+    }
+    // Left = face a (negative side), right = face b.
+    for g in groups {
+        let Some(&rmax_s) = g.scales.last() else {
+            continue;
+        };
+        let rmax = radii[rmax_s];
+        scratch.cand.clear();
+        let cand = &mut scratch.cand;
+        g.grid.for_each_within(m, rmax, |it, d2| {
+            if it.face as usize != fa && it.face as usize != fb {
+                cand.push(Cand {
+                    sd: vec3::dot(vec3::sub(it.c, m), s),
+                    d2,
+                    n: it.n,
+                    area: it.area,
+                });
+            }
+        });
+        // Sort by |distance to the plane| (as f32, whose bits order like the values), ties by
+        // the fixed grid order: integer keys sort several times faster than float pairs.
+        scratch.keys.clear();
+        scratch.keys.extend(
+            cand.iter()
+                .enumerate()
+                .map(|(i, c)| (u64::from((c.sd.abs() as f32).to_bits()) << 32) | i as u64),
+        );
+        scratch.keys.sort_unstable();
+        scratch.sorted.clear();
+        scratch.sorted.extend(
+            scratch
+                .keys
+                .iter()
+                .map(|&k| cand[(k & 0xFFFF_FFFF) as usize]),
+        );
+        std::mem::swap(&mut scratch.cand, &mut scratch.sorted);
+        for &si in &g.scales {
+            let r2 = radii[si] * radii[si];
+            let mut init = [na, nb];
+            if params.mean_init {
+                let mut sum = [[0.0; 3]; 2];
+                for c in scratch.cand.iter() {
+                    if c.d2 <= r2 {
+                        let k = usize::from(c.sd >= 0.0);
+                        sum[k] = vec3::add(sum[k], vec3::scale(c.n, c.area));
+                    }
+                }
+                for k in 0..2 {
+                    if let Some(u) = vec3::normalize(sum[k]) {
+                        init[k] = u;
+                    }
+                }
+            }
+            for it in 0..params.iterations.max(1) {
+                init = grow(
+                    em,
+                    fa,
+                    fb,
+                    init,
+                    it == 0,
+                    &scratch.cand,
+                    r2,
+                    cos_accept,
+                    &mut scratch.rejected,
+                );
+            }
+            out[si] = vec3::angle(init[0], init[1]);
+        }
+    }
+}
+
+/// The region growing of section 3.2 over the candidates (sorted by distance to the
+/// separating plane) whose squared distance to the midpoint is at most `r2`, starting from the
+/// normals `init`, with the edge's two faces in their regions from the start if `seeds`.
+/// (Testing the two faces like the other candidates instead, with the mean initialisation,
+/// was measured: 17 instead of 147 false edges on the 0.5 %-noise grid, but the mean AUC of
+/// Table 2 fell from 87.5 % to 85.0 % on the noisy meshes and from 97.2 % to 94.7 % on the
+/// clean ones.)
+#[allow(clippy::too_many_arguments)]
+fn grow(
+    em: &EdgeMesh,
+    fa: usize,
+    fb: usize,
+    init: [Point3; 2],
+    seeds: bool,
+    cand: &[Cand],
+    r2: f64,
+    cos_accept: f64,
+    rejected: &mut Vec<u32>,
+) -> [Point3; 2] {
+    let w = if seeds { 1.0 } else { 0.0 };
+    let mut sum = [
+        vec3::scale(em.normals[fa], w * em.areas[fa]),
+        vec3::scale(em.normals[fb], w * em.areas[fb]),
+    ];
+    let mut normal = init;
+    rejected.clear();
+    let try_add =
+        |side: usize, n: Point3, area: f64, sum: &mut [Point3; 2], normal: &mut [Point3; 2]| {
+            if vec3::dot(n, normal[side]) > cos_accept {
+                sum[side] = vec3::add(sum[side], vec3::scale(n, area));
+                if let Some(u) = vec3::normalize(sum[side]) {
+                    normal[side] = u;
+                }
+                true
+            } else {
+                false
+            }
+        };
+    for (i, c) in cand.iter().enumerate() {
+        if c.d2 > r2 {
+            continue;
+        }
+        let side = usize::from(c.sd >= 0.0);
+        if !try_add(side, c.n, c.area, &mut sum, &mut normal) {
+            rejected.push(i as u32);
+        }
+    }
+    for &i in rejected.iter() {
+        let c = &cand[i as usize];
+        try_add(usize::from(c.sd >= 0.0), c.n, c.area, &mut sum, &mut normal);
+    }
+    normal
+}
