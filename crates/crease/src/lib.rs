@@ -19,6 +19,7 @@ pub mod graphcut;
 pub mod io;
 pub mod lines;
 pub mod render;
+pub mod segment;
 pub mod sharp;
 pub mod spatial;
 pub mod synth;
