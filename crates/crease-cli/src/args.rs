@@ -66,6 +66,9 @@ pub enum Command {
     /// Score a labelled output against ground truth: precision, recall, F1, MCC, IoU, tolerant
     /// scores, ROC and AUC.
     Eval(crate::commands::eval::EvalArgs),
+    /// Segment a triangle mesh into planes, cylinders, cones, spheres and tori with their
+    /// parameters (Mizoguchi et al.).
+    Segment(crate::commands::segment::SegmentArgs),
     /// Run every capability on a built-in synthetic part; no input files needed.
     Demo {
         /// Folder to write the results into.

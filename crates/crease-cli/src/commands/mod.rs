@@ -8,6 +8,7 @@ mod info;
 pub(crate) mod lines;
 pub(crate) mod normals;
 mod render;
+pub(crate) mod segment;
 pub(crate) mod sharp;
 mod synth;
 
@@ -36,6 +37,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sharp(a) => sharp::run(g, &a),
         Command::Lines(a) => lines::run(g, &a),
         Command::Eval(a) => eval::run(g, &a),
+        Command::Segment(a) => segment::run(g, &a),
     }
 }
 

@@ -4,7 +4,8 @@
 //! (section 5.1, refined, see [`super::fit`]) is first checked against the seed itself: only
 //! the seed vertices compatible with it (equations 4 and 5) are kept, and the seed is dropped
 //! when fewer than half of them (or fewer than `th_seed`) are. This check is not in the paper;
-//! it discards the seeds of mislabelled vertices (e.g. blends between two surfaces labelled
+//! residual seeds (see `SegmentParams::residual_seeds`) need a quarter. This check
+//! discards the seeds of mislabelled vertices (e.g. blends between two surfaces labelled
 //! torus by Step 3) before they grow. A vertex adjacent to the region joins it when it belongs
 //! to no region yet and satisfies
 //! - equation 4: `|v_i − p(v_i)| < th_pos · l̄`, with `p(v_i)` the nearest point of the
@@ -71,7 +72,8 @@ impl Ctx<'_> {
         fit(kind, &pts, &nrm, &w)
     }
 
-    fn ok(&self, s: &SurfaceParams, v: u32) -> bool {
+    /// Equations 4 and 5 for vertex `v`.
+    pub fn ok(&self, s: &SurfaceParams, v: u32) -> bool {
         self.tol
             .ok(s, self.pos[v as usize], self.vnormal[v as usize])
     }
@@ -110,6 +112,7 @@ pub(crate) fn grow_seed(
     seed: &[u32],
     seed_fit: Option<Fit>,
     min_seed: usize,
+    min_core_fraction: f64,
     id: i32,
     owner: &mut [i32],
 ) -> Option<Region> {
@@ -121,16 +124,17 @@ pub(crate) fn grow_seed(
     if free.len() < min_seed.max(1) {
         return None;
     }
+    // The seed's fit stays valid when bigger regions took some of its vertices.
     let f = match seed_fit {
-        Some(f) if free.len() == seed.len() => f,
-        _ => ctx.fit(kind, &free)?,
+        Some(f) => f,
+        None => ctx.fit(kind, &free)?,
     };
     let core: Vec<u32> = free
         .iter()
         .copied()
         .filter(|&v| ctx.ok(&f.params, v))
         .collect();
-    if core.len() < min_seed.max(1) || 2 * core.len() < free.len() {
+    if core.len() < min_seed.max(1) || (core.len() as f64) < min_core_fraction * free.len() as f64 {
         return None;
     }
     let mut region = core;

@@ -13,12 +13,15 @@
 //!    refit (section 5.2, [`grow`]);
 //! 5. per-face surfaces, surface areas, RMS errors and adjacency.
 //!
-//! **Type choice between cylinder and cone.** Equation 3 tells cones from cylinders by the
-//! variation of `κ_max` over a 2-ring, which is small on both when the mesh is fine or the cone
-//! slender, and noisy on irregular tessellations. So a seed labelled cylinder or cone is fitted
-//! with both, and the cone is kept only when its RMS error is below `cone_gain` times the
-//! cylinder's (and its half angle above `min_cone_angle`). This model selection is an addition
-//! to the paper.
+//! **Model selection (an addition to the paper).** The labels of section 4 decide a seed's type
+//! in the paper. They are fragile where curvature estimates are: equation 3 tells cones from
+//! cylinders by the variation of `κ_max` over a 2-ring, which is small on both when the mesh is
+//! fine or the cone slender and noisy on irregular tessellations; on small CAD patches (the
+//! ABC model's cone chamfers) the curvature fits near the borders give neither `κ_min ≈ 0` nor
+//! equal curvatures, so the vertices end with label 0 and Step 3 calls them torus. So every seed
+//! is fitted with its label's type and with the simpler types that type can degenerate to, and
+//! the simplest one that fits about as well as the best is kept (see `SegmentParams::
+//! simpler_factor`); cones slimmer than `min_cone_angle_degrees` are not considered.
 //!
 //! Surface-type codes (PLY `surface_type`, uchar) are those of
 //! [`SurfaceType`](crate::synth::SurfaceType): plane 0, cylinder 1, cone 2, sphere 3, torus 4,
@@ -34,7 +37,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::estimate::bezier::{bezier_curvature, BezierParams};
+use crate::estimate::bezier::{bezier_curvature_with_sharp, BezierParams};
 use crate::geometry::{face_areas, Aabb, MeshTopology, TriMesh};
 use crate::synth::{SurfaceParams, SurfaceType};
 use crate::{Error, Result};
@@ -48,17 +51,35 @@ pub use labels::{label, LabelParams};
 pub struct SegmentParams {
     /// Curvature estimation (section 3; W = 2 then 5, `th_se` relative to the edge length).
     pub bezier: BezierParams,
+    /// Vertices on a mesh edge whose dihedral angle exceeds this (degrees) are sharp vertices
+    /// in addition to those of `th_se` (default 30). Not in the paper: on CAD tessellations the
+    /// vertices of moderate creases (45° chamfers) stay below `th_se`, and the second-pass fits
+    /// of the narrow patches between such creases reach across them (measured on the ABC model:
+    /// `κ_max l̄` of 0.17–0.29 instead of 0.02 on its chamfer cones). A smooth surface of radius
+    /// `r` has dihedral angles of about `l̄ / r` radians, so 30° only touches radii below two
+    /// edge lengths.
+    pub crease_angle_degrees: f64,
     /// Labels and seeds (section 4).
     pub labels: LabelParams,
     /// `th_pos` of equation 4 in units of the mean edge length (paper: 0.5).
     pub th_pos: f64,
     /// `th_norm` of equation 5 in degrees (paper: 8).
     pub th_norm_degrees: f64,
-    /// A cone replaces a cylinder fit when its RMS error is below this fraction of the
-    /// cylinder's (default 0.5).
-    pub cone_gain: f64,
+    /// Model selection: a simpler surface type is kept when its RMS error is at most this
+    /// factor times the best candidate's (plus `simpler_floor`); default 1.5.
+    pub simpler_factor: f64,
+    /// Model selection: allowance added to the RMS bound, in mean edge lengths (default 0.001).
+    pub simpler_floor: f64,
     /// Smallest half angle (degrees) a cone may have; slimmer ones are cylinders (default 1).
     pub min_cone_angle_degrees: f64,
+    /// After growing, the connected sets of vertices left in no region and not on a crease
+    /// (`crease_angle_degrees`; vertices sharp by `th_se` alone take part, as fillets of a few
+    /// edges' radius on noisy meshes pass it) (at least
+    /// `th_seed` of the torus, 7) become seeds of any type and grow too, for up to three rounds
+    /// (default true). Not in
+    /// the paper: small patches whose curvature labels are spoiled by their neighbours (the
+    /// spherical corners between three fillets) get no seed of their own otherwise.
+    pub residual_seeds: bool,
     /// Rounds of face propagation for faces whose vertices belong to no compatible region
     /// (default 3).
     pub face_passes: usize,
@@ -68,11 +89,14 @@ impl Default for SegmentParams {
     fn default() -> Self {
         SegmentParams {
             bezier: BezierParams::default(),
+            crease_angle_degrees: 30.0,
             labels: LabelParams::default(),
             th_pos: 0.5,
             th_norm_degrees: 8.0,
-            cone_gain: 0.5,
+            simpler_factor: 1.5,
+            simpler_floor: 0.001,
             min_cone_angle_degrees: 1.0,
+            residual_seeds: true,
             face_passes: 3,
         }
     }
@@ -143,14 +167,85 @@ fn type_name<S: serde::Serializer>(t: &SurfaceType, s: S) -> std::result::Result
     s.serialize_str(t.name())
 }
 
-fn seed_kind(l: u8) -> SurfaceType {
-    match l {
-        label::PLANE => SurfaceType::Plane,
-        label::CYLINDER => SurfaceType::Cylinder,
-        label::SPHERE => SurfaceType::Sphere,
-        label::CONE => SurfaceType::Cone,
-        label::TORUS => SurfaceType::Torus,
-        _ => SurfaceType::Other,
+/// The fit of a seed: the simplest candidate type (plane, sphere, cylinder, cone, torus in
+/// that order) whose RMS error is at most `simpler_factor` times the best candidate's plus
+/// `simpler_floor · l̄`. Candidates: the seed's label type and the simpler types it can
+/// degenerate to (cylinder / cone seeds: plane, cylinder, cone; sphere: plane, sphere; torus:
+/// all five).
+fn select_model(
+    ctx: &grow::Ctx,
+    lab: u8,
+    vs: &[u32],
+    params: &SegmentParams,
+    min_cone: f64,
+    l: f64,
+) -> Option<(SurfaceType, Fit)> {
+    use SurfaceType as T;
+    let cands: &[T] = match lab {
+        label::PLANE => &[T::Plane],
+        label::CYLINDER | label::CONE => &[T::Plane, T::Cylinder, T::Cone],
+        label::SPHERE => &[T::Plane, T::Sphere],
+        label::TORUS => &[T::Plane, T::Sphere, T::Cylinder, T::Cone, T::Torus],
+        _ => return None,
+    };
+    // Trimmed fits: refit to the seed vertices compatible with the fit (equations 4 and 5),
+    // up to three times, so that seeds polluted by mislabelled border vertices still give
+    // the surface of their majority.
+    let fits: Vec<(T, Fit, usize)> = cands
+        .iter()
+        .filter(|&&k| vs.len() >= min_points(k))
+        .filter_map(|&k| {
+            let mut f = ctx.fit(k, vs)?;
+            let mut current: Vec<u32> = vs.to_vec();
+            for _ in 0..3 {
+                let inl: Vec<u32> = vs
+                    .iter()
+                    .copied()
+                    .filter(|&v| ctx.ok(&f.params, v))
+                    .collect();
+                if inl.len() < min_points(k).max(vs.len() / 4) {
+                    break;
+                }
+                if inl == current {
+                    break;
+                }
+                match ctx.fit(k, &inl) {
+                    Some(g) => f = g,
+                    None => break,
+                }
+                current = inl;
+            }
+            let inl = vs.iter().filter(|&&v| ctx.ok(&f.params, v)).count();
+            Some((k, f, inl))
+        })
+        .filter(|(_, f, _)| match f.params {
+            SurfaceParams::Cone { half_angle, .. } => half_angle >= min_cone,
+            _ => true,
+        })
+        .collect();
+    let best_count = fits.iter().map(|x| x.2).max()?;
+    let eligible: Vec<&(T, Fit, usize)> = fits
+        .iter()
+        .filter(|x| x.2 as f64 >= 0.9 * best_count as f64)
+        .collect();
+    let best = eligible
+        .iter()
+        .map(|(_, f, _)| f.rms)
+        .fold(f64::INFINITY, f64::min);
+    let bound = params.simpler_factor * best + params.simpler_floor * l;
+    eligible
+        .into_iter()
+        .find(|(_, f, _)| f.rms <= bound)
+        .map(|(k, f, _)| (*k, *f))
+}
+
+/// Fewest points a fit of `k` needs.
+fn min_points(k: SurfaceType) -> usize {
+    match k {
+        SurfaceType::Plane => 2,
+        SurfaceType::Cylinder | SurfaceType::Cone => 4,
+        SurfaceType::Sphere => 4,
+        SurfaceType::Torus | SurfaceType::Other => 7,
     }
 }
 
@@ -175,7 +270,18 @@ pub fn segment_mesh(
     }
     let mut timings = Vec::new();
     let t = Instant::now();
-    let bez = bezier_curvature(mesh, topo, &params.bezier)?;
+    // Vertices on creases of dihedral angle above `crease_angle_degrees` are sharp too.
+    let dihedral = topo.dihedral_angles();
+    let crease = params.crease_angle_degrees.to_radians();
+    let forced: Vec<bool> = (0..mesh.num_vertices())
+        .into_par_iter()
+        .map(|v| {
+            topo.vertex_edges(v)
+                .iter()
+                .any(|&e| dihedral[e as usize] > crease)
+        })
+        .collect();
+    let bez = bezier_curvature_with_sharp(mesh, topo, &params.bezier, Some(&forced))?;
     timings.push(("curvature", t.elapsed().as_secs_f64()));
     let t = Instant::now();
     let nv = mesh.num_vertices();
@@ -186,12 +292,11 @@ pub fn segment_mesh(
         .ok_or_else(|| Error::InvalidInput("segmentation: the mesh has no extent".into()))?;
     let eps = params.labels.epsilon(l, diag);
     let c = &bez.curvature;
-    let (kmax, kmin): (Vec<f64>, Vec<f64>) = c
-        .k1
-        .iter()
-        .zip(&c.k2)
-        .map(|(&a, &b)| if a.abs() >= b.abs() { (a, b) } else { (b, a) })
-        .unzip();
+    let (kmax, kmin): (Vec<f64>, Vec<f64>) =
+        c.k1.iter()
+            .zip(&c.k2)
+            .map(|(&a, &b)| if a.abs() >= b.abs() { (a, b) } else { (b, a) })
+            .unzip();
     let vertex_labels =
         labels::vertex_labels(&kmax, &kmin, &bez.sharp, topo, eps, l, &params.labels);
     let seeds = labels::seed_regions(&vertex_labels, topo, &params.labels);
@@ -227,36 +332,11 @@ pub fn segment_mesh(
         weight: &weight,
         tol,
     };
-    // Seed fits, with the cylinder / cone model selection.
+    // Seed fits, with the model selection.
     let min_cone = params.min_cone_angle_degrees.to_radians();
     let fitted: Vec<Option<(SurfaceType, Fit)>> = seeds
         .par_iter()
-        .map(|(lab, vs)| {
-            let kind = seed_kind(*lab);
-            match kind {
-                SurfaceType::Cylinder | SurfaceType::Cone => {
-                    let cyl = ctx.fit(SurfaceType::Cylinder, vs);
-                    let cone = if vs.len() >= 6 {
-                        ctx.fit(SurfaceType::Cone, vs)
-                    } else {
-                        None
-                    };
-                    let cone_ok = |c: &Fit| match c.params {
-                        SurfaceParams::Cone { half_angle, .. } => half_angle >= min_cone,
-                        _ => false,
-                    };
-                    match (cyl, cone) {
-                        (Some(a), Some(b)) if cone_ok(&b) && b.rms < params.cone_gain * a.rms => {
-                            Some((SurfaceType::Cone, b))
-                        }
-                        (Some(a), _) => Some((SurfaceType::Cylinder, a)),
-                        (None, Some(b)) if cone_ok(&b) => Some((SurfaceType::Cone, b)),
-                        _ => None,
-                    }
-                }
-                _ => ctx.fit(kind, vs).map(|f| (kind, f)),
-            }
-        })
+        .map(|(lab, vs)| select_model(&ctx, *lab, vs, params, min_cone, l))
         .collect();
     timings.push(("seed fits", t.elapsed().as_secs_f64()));
 
@@ -276,17 +356,48 @@ pub fn segment_mesh(
             vs,
             Some(f),
             min_seed,
+            0.25,
             regions.len() as i32,
             &mut owner,
         ) {
             regions.push(r);
         }
     }
+    // Residual seeds: connected sets of vertices no region took.
+    if params.residual_seeds {
+        let min = params.labels.seed_size(label::TORUS);
+        for _round in 0..3 {
+            let mut unowned = vec![label::OTHER; nv];
+            for v in 0..nv {
+                if owner[v] == -1 && !forced[v] {
+                    unowned[v] = label::TORUS;
+                }
+            }
+            let mut rest = labels::seed_regions(&unowned, topo, &params.labels);
+            rest.retain(|(_, vs)| vs.len() >= min);
+            rest.sort_by_key(|(_, vs)| std::cmp::Reverse(vs.len()));
+            let fitted: Vec<Option<(SurfaceType, Fit)>> = rest
+                .par_iter()
+                .map(|(lab, vs)| select_model(&ctx, *lab, vs, params, min_cone, l))
+                .collect();
+            let before = regions.len();
+            for ((_, vs), f) in rest.iter().zip(fitted) {
+                let Some((kind, f)) = f else { continue };
+                let id = regions.len() as i32;
+                if let Some(r) = grow::grow_seed(&ctx, kind, vs, Some(f), min, 0.25, id, &mut owner)
+                {
+                    regions.push(r);
+                }
+            }
+            if regions.len() == before {
+                break;
+            }
+        }
+    }
     timings.push(("growing", t.elapsed().as_secs_f64()));
 
     let t = Instant::now();
-    let face_surface =
-        grow::assign_faces(mesh, topo, &owner, &regions, &tol, params.face_passes);
+    let face_surface = grow::assign_faces(mesh, topo, &owner, &regions, &tol, params.face_passes);
     let surfaces = summarise(topo, &regions, &face_surface, &areas, &ctx);
     timings.push(("faces", t.elapsed().as_secs_f64()));
     Ok(Segmentation {

@@ -204,7 +204,13 @@ pub fn param_error(got: &SurfaceParams, truth: &SurfaceParams) -> ParamError {
             position: Some(norm(cross(sub(axis_point, p2), d2))),
             ..Default::default()
         },
-        (S::Sphere { center, radius }, S::Sphere { center: c2, radius: r2 }) => ParamError {
+        (
+            S::Sphere { center, radius },
+            S::Sphere {
+                center: c2,
+                radius: r2,
+            },
+        ) => ParamError {
             radius: Some((radius - r2).abs() / r2),
             position: Some(norm(sub(center, c2))),
             ..Default::default()
@@ -240,9 +246,7 @@ pub fn param_error(got: &SurfaceParams, truth: &SurfaceParams) -> ParamError {
                 minor_radius: r2,
             },
         ) => ParamError {
-            radius: Some(
-                ((major_radius - rr2).abs() / rr2).max((minor_radius - r2).abs() / r2),
-            ),
+            radius: Some(((major_radius - rr2).abs() / rr2).max((minor_radius - r2).abs() / r2)),
             axis_degrees: Some(axis_angle(axis_dir, d2)),
             position: Some(norm(sub(center, c2))),
             ..Default::default()
@@ -308,7 +312,11 @@ pub fn read_abc_truth(labels: &Path, primitives: &Path) -> Result<AbcTruth> {
     })?;
     let v3 = |v: &serde_json::Value| -> Option<[f64; 3]> {
         let a = v.as_array()?;
-        Some([a.first()?.as_f64()?, a.get(1)?.as_f64()?, a.get(2)?.as_f64()?])
+        Some([
+            a.first()?.as_f64()?,
+            a.get(1)?.as_f64()?,
+            a.get(2)?.as_f64()?,
+        ])
     };
     let unit = |v: [f64; 3]| crate::geometry::vec3::normalize(v);
     let surfaces = list
@@ -318,7 +326,11 @@ pub fn read_abc_truth(labels: &Path, primitives: &Path) -> Result<AbcTruth> {
             match abc_type(t) {
                 SurfaceType::Plane => {
                     let c = s["coefficients"].as_array()?;
-                    let n = [c.first()?.as_f64()?, c.get(1)?.as_f64()?, c.get(2)?.as_f64()?];
+                    let n = [
+                        c.first()?.as_f64()?,
+                        c.get(1)?.as_f64()?,
+                        c.get(2)?.as_f64()?,
+                    ];
                     let len = norm(n);
                     Some(SurfaceParams::Plane {
                         normal: unit(n)?,
