@@ -512,7 +512,12 @@ fn finite(s: &SurfaceParams) -> bool {
             apex,
             axis_dir,
             half_angle,
-        } => ok3(apex) && ok3(axis_dir) && *half_angle > 0.0 && *half_angle < 1.5707963,
+        } => {
+            ok3(apex)
+                && ok3(axis_dir)
+                && *half_angle > 0.0
+                && *half_angle < std::f64::consts::FRAC_PI_2
+        }
         SurfaceParams::Torus {
             center,
             axis_dir,
@@ -540,7 +545,7 @@ pub fn refine(init: &SurfaceParams, pts: &[Point3], w: &[f64]) -> Option<Surface
             break;
         };
         let r = rms_distance(&next, &sp, &sw);
-        if !(r < rms) {
+        if r.is_nan() || r >= rms {
             break;
         }
         let gain = (rms - r) / rms.max(1e-300);
@@ -554,15 +559,15 @@ pub fn refine(init: &SurfaceParams, pts: &[Point3], w: &[f64]) -> Option<Surface
 }
 
 fn refine_once(init: &SurfaceParams, sp: &[Point3], sw: &[f64]) -> Option<SurfaceParams> {
-    let ext = extent(&sp);
+    let ext = extent(sp);
     let out = match *init {
-        SurfaceParams::Plane { .. } => return plane_refine(init, &sp, &sw),
+        SurfaceParams::Plane { .. } => return plane_refine(init, sp, sw),
         SurfaceParams::Sphere { center, radius } => {
             let f = |x: &[f64; 4]| SurfaceParams::Sphere {
                 center: add(center, [x[0], x[1], x[2]]),
                 radius: radius + x[3],
             };
-            let x = lm([0.0; 4], [ext, ext, ext, ext], &sp, &sw, |x| f(x))?;
+            let x = lm([0.0; 4], [ext, ext, ext, ext], sp, sw, |x| f(x))?;
             f(&x)
         }
         SurfaceParams::Cylinder {
@@ -577,7 +582,7 @@ fn refine_once(init: &SurfaceParams, sp: &[Point3], sw: &[f64]) -> Option<Surfac
                     .unwrap_or(axis_dir),
                 radius: radius + x[4],
             };
-            let x = lm([0.0; 5], [ext, ext, 1.0, 1.0, ext], &sp, &sw, |x| f(x))?;
+            let x = lm([0.0; 5], [ext, ext, 1.0, 1.0, ext], sp, sw, |x| f(x))?;
             f(&x)
         }
         SurfaceParams::Cone {
@@ -590,7 +595,7 @@ fn refine_once(init: &SurfaceParams, sp: &[Point3], sw: &[f64]) -> Option<Surfac
             // undetermined along the axis, and with it as a parameter LM crawls along that
             // valley (measured on the ABC model's chamfer cones: still 16° off after 60
             // iterations).
-            let c = centroid(&sp, &sw)?;
+            let c = centroid(sp, sw)?;
             let hc = dot(sub(c, apex), axis_dir);
             let p0 = add(apex, scale(axis_dir, hc));
             let r0 = hc * half_angle.tan();
@@ -607,7 +612,7 @@ fn refine_once(init: &SurfaceParams, sp: &[Point3], sw: &[f64]) -> Option<Surfac
                     half_angle: th,
                 }
             };
-            let x = lm([0.0; 6], [ext, ext, 1.0, 1.0, ext, 1.0], &sp, &sw, |x| f(x))?;
+            let x = lm([0.0; 6], [ext, ext, 1.0, 1.0, ext, 1.0], sp, sw, |x| f(x))?;
             f(&x)
         }
         SurfaceParams::Torus {
@@ -624,17 +629,13 @@ fn refine_once(init: &SurfaceParams, sp: &[Point3], sw: &[f64]) -> Option<Surfac
                 major_radius: major_radius + x[5],
                 minor_radius: minor_radius + x[6],
             };
-            let x = lm(
-                [0.0; 7],
-                [ext, ext, ext, 1.0, 1.0, ext, ext],
-                &sp,
-                &sw,
-                |x| f(x),
-            )?;
+            let x = lm([0.0; 7], [ext, ext, ext, 1.0, 1.0, ext, ext], sp, sw, |x| {
+                f(x)
+            })?;
             f(&x)
         }
     };
-    let out = canonical(out, &sp, &sw);
+    let out = canonical(out, sp, sw);
     finite(&out).then_some(out)
 }
 

@@ -3,10 +3,11 @@
 //! **Growing.** Seeds are processed in descending order of their vertex count. A seed's fit
 //! (section 5.1, refined, see [`super::fit`]) is first checked against the seed itself: only
 //! the seed vertices compatible with it (equations 4 and 5) are kept, and the seed is dropped
-//! when fewer than half of them (or fewer than `th_seed`) are. This check is not in the paper;
-//! residual seeds (see `SegmentParams::residual_seeds`) need a quarter. This check
-//! discards the seeds of mislabelled vertices (e.g. blends between two surfaces labelled
-//! torus by Step 3) before they grow. A vertex adjacent to the region joins it when it belongs
+//! when fewer than a quarter of its free vertices (or fewer than `th_seed`) are. This check is
+//! not in the paper; it discards the seeds of mislabelled vertices (e.g. blends between two
+//! surfaces labelled torus by Step 3) before they grow, while a seed that spans two surfaces
+//! (a fillet's cylinder labels running on into the spherical corner) still grows from the part
+//! its fit explains; the rest is picked up by the residual seeds. A vertex adjacent to the region joins it when it belongs
 //! to no region yet and satisfies
 //! - equation 4: `|v_i − p(v_i)| < th_pos · l̄`, with `p(v_i)` the nearest point of the
 //!   surface (the paper projects along `n_i`; near the surface, where the test matters, both
@@ -105,14 +106,14 @@ fn grow_bfs(ctx: &Ctx, s: &SurfaceParams, id: i32, region: &mut Vec<u32>, owner:
 }
 
 /// Grows `seed` (type, vertices, its fit) into a region with id `id`. `None` if the seed fails
-/// its own check.
+/// its own check: fewer than `min_seed` compatible vertices, or fewer than `min_core_fraction`
+/// of its vertices still free.
 pub(crate) fn grow_seed(
     ctx: &Ctx,
     kind: SurfaceType,
     seed: &[u32],
     seed_fit: Option<Fit>,
-    min_seed: usize,
-    min_core_fraction: f64,
+    (min_seed, min_core_fraction): (usize, f64),
     id: i32,
     owner: &mut [i32],
 ) -> Option<Region> {

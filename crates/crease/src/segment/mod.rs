@@ -260,8 +260,10 @@ pub fn segment_mesh(
     topo: &MeshTopology,
     params: &SegmentParams,
 ) -> Result<Segmentation> {
-    if !(params.th_pos > 0.0 && params.th_pos.is_finite())
-        || !(params.th_norm_degrees > 0.0 && params.th_norm_degrees < 90.0)
+    if !(params.th_pos > 0.0
+        && params.th_pos.is_finite()
+        && params.th_norm_degrees > 0.0
+        && params.th_norm_degrees < 90.0)
     {
         return Err(Error::InvalidArgument(format!(
             "segmentation: th_pos must be positive and th_norm in (0, 90) degrees, got {} and {}",
@@ -355,8 +357,7 @@ pub fn segment_mesh(
             kind,
             vs,
             Some(f),
-            min_seed,
-            0.25,
+            (min_seed, 0.25),
             regions.len() as i32,
             &mut owner,
         ) {
@@ -384,7 +385,8 @@ pub fn segment_mesh(
             for ((_, vs), f) in rest.iter().zip(fitted) {
                 let Some((kind, f)) = f else { continue };
                 let id = regions.len() as i32;
-                if let Some(r) = grow::grow_seed(&ctx, kind, vs, Some(f), min, 0.25, id, &mut owner)
+                if let Some(r) =
+                    grow::grow_seed(&ctx, kind, vs, Some(f), (min, 0.25), id, &mut owner)
                 {
                     regions.push(r);
                 }

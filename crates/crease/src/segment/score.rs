@@ -102,7 +102,7 @@ pub fn score_faces(
     let mut ids: Vec<i32> = truth_area.keys().copied().collect();
     ids.sort_unstable();
     let mut pairs: Vec<((i32, i32), f64)> = inter.into_iter().collect();
-    pairs.sort_by(|a, b| a.0.cmp(&b.0));
+    pairs.sort_by_key(|a| a.0);
     let matches: Vec<SurfaceMatch> = ids
         .iter()
         .map(|&t| {
