@@ -25,7 +25,8 @@ pub struct SegmentArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Write the surfaces (type, parameters, area, counts, RMS error, neighbours) to this JSON
-    /// file. (The global --json prints a run summary on stdout.)
+    /// file. (The global --json prints a run summary on stdout, the surfaces included as
+    /// `surface_list`.)
     #[arg(long, value_name = "JSON")]
     pub primitives: Option<PathBuf>,
     /// Also draw the mesh coloured by surface type into this PNG.
@@ -146,6 +147,8 @@ pub fn run(g: &Global, a: &SegmentArgs) -> anyhow::Result<()> {
             "assigned_faces": assigned, "surface_area": total_area,
             "mean_edge": seg.mean_edge, "epsilon": seg.epsilon,
             "timings": timings, "seconds": seconds,
+            "surface_type_codes": doc["surface_type_codes"],
+            "surface_list": doc["surfaces"],
         }))?;
     } else if !g.quiet {
         eprintln!(
