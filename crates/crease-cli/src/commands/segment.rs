@@ -51,7 +51,7 @@ pub fn run(g: &Global, a: &SegmentArgs) -> anyhow::Result<()> {
     for o in &outputs {
         crate::ui::ensure_not_input(o, &[&a.input])?;
     }
-    if !(a.th_pos > 0.0 && a.th_pos.is_finite()) || !(a.th_norm > 0.0 && a.th_norm < 90.0) {
+    if !(a.th_pos > 0.0 && a.th_pos.is_finite() && a.th_norm > 0.0 && a.th_norm < 90.0) {
         return Err(usage(format!(
             "--th-pos must be positive and --th-norm in (0, 90) degrees, got {} and {}",
             a.th_pos, a.th_norm
