@@ -86,5 +86,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             f(e.half_angle_degrees, 1.0)
         );
     }
+    for g in &seg.groups {
+        let types: Vec<&str> = g
+            .surfaces
+            .iter()
+            .map(|&s| seg.surfaces[s as usize].kind.name())
+            .collect();
+        println!(
+            "{:?}: surfaces {:?} ({})",
+            g.kind,
+            g.surfaces,
+            types.join(", ")
+        );
+    }
     Ok(())
 }

@@ -5,6 +5,7 @@
 mod common;
 
 use crease::geometry::{face_areas, MeshTopology};
+use crease::segment::recognize::GroupKind;
 use crease::segment::score::{param_error, read_abc_truth, score_faces, SegmentScore};
 use crease::segment::{segment_mesh, SegmentParams, Segmentation};
 use crease::synth::{self, MeshParams, Noise, NoiseScale, Shape, SurfaceType};
@@ -224,4 +225,50 @@ fn segmentation_is_deterministic_across_thread_counts() {
     let (a, b) = (run(1), run(2));
     assert_eq!(a.face_surface, b.face_surface);
     assert_eq!(a.surfaces, b.surfaces);
+}
+
+#[test]
+fn fillets_extrusions_revolutions_are_recognised() {
+    let count =
+        |seg: &Segmentation, k: GroupKind| seg.groups.iter().filter(|g| g.kind == k).count();
+    // Rounded cube: 12 cylinder fillets between two planes, 8 spheres between three of them.
+    let (_, seg, _) = run_synth("rounded-cube", 0.0);
+    let fillets: Vec<_> = seg
+        .groups
+        .iter()
+        .filter(|g| g.kind == GroupKind::Fillet)
+        .collect();
+    let by = |t: SurfaceType| {
+        fillets
+            .iter()
+            .filter(|g| seg.surfaces[g.surfaces[0] as usize].kind == t)
+            .count()
+    };
+    eprintln!(
+        "rounded cube groups: {:?}",
+        seg.groups
+            .iter()
+            .map(|g| (g.kind, g.surfaces.len()))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(by(SurfaceType::Cylinder), 12);
+    assert_eq!(by(SurfaceType::Sphere), 8);
+    // Block with fillet, chamfer and cone: the fillet between the top and the side, the cone
+    // and its flat top a surface of revolution, no other fillet (the chamfer is a plane).
+    let (_, seg, _) = run_synth("fillet-chamfer-cone", 0.0);
+    eprintln!("fillet-chamfer-cone groups: {:?}", seg.groups);
+    assert_eq!(count(&seg, GroupKind::Fillet), 1);
+    let rev: Vec<_> = seg
+        .groups
+        .iter()
+        .filter(|g| g.kind == GroupKind::Revolution)
+        .collect();
+    assert!(rev.iter().any(|g| g
+        .surfaces
+        .iter()
+        .any(|&s| seg.surfaces[s as usize].kind == SurfaceType::Cone)));
+    // Box with a hole: no fillet (the hole meets its planes at right angles).
+    let (_, seg, _) = run_synth("box-hole", 0.0);
+    assert_eq!(count(&seg, GroupKind::Fillet), 0);
+    assert!(count(&seg, GroupKind::Extrusion) >= 1);
 }

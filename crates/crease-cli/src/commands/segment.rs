@@ -102,6 +102,7 @@ pub fn run(g: &Global, a: &SegmentArgs) -> anyhow::Result<()> {
         "mean_edge": seg.mean_edge,
         "epsilon": seg.epsilon,
         "surfaces": seg.surfaces,
+        "groups": seg.groups,
     });
     if let Some(p) = &a.primitives {
         std::fs::write(p, serde_json::to_string_pretty(&doc)? + "\n")
@@ -149,6 +150,7 @@ pub fn run(g: &Global, a: &SegmentArgs) -> anyhow::Result<()> {
             "timings": timings, "seconds": seconds,
             "surface_type_codes": doc["surface_type_codes"],
             "surface_list": doc["surfaces"],
+            "groups": doc["groups"],
         }))?;
     } else if !g.quiet {
         eprintln!(

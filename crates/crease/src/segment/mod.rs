@@ -11,7 +11,8 @@
 //!    Levenberg–Marquardt refinement);
 //! 4. region growing in descending seed size with the tolerances of equations 4 and 5, and a
 //!    refit (section 5.2, [`grow`]);
-//! 5. per-face surfaces, surface areas, RMS errors and adjacency.
+//! 5. per-face surfaces, surface areas, RMS errors and adjacency;
+//! 6. fillets, linear extrusions and surfaces of revolution (section 6, [`recognize`]).
 //!
 //! **Model selection (an addition to the paper).** The labels of section 4 decide a seed's type
 //! in the paper. They are fragile where curvature estimates are: equation 3 tells cones from
@@ -30,6 +31,7 @@
 pub mod fit;
 pub mod grow;
 pub mod labels;
+pub mod recognize;
 pub mod score;
 
 use std::time::Instant;
@@ -80,6 +82,9 @@ pub struct SegmentParams {
     /// the paper: small patches whose curvature labels are spoiled by their neighbours (the
     /// spherical corners between three fillets) get no seed of their own otherwise.
     pub residual_seeds: bool,
+    /// Angle tolerance (degrees) of the parallel / orthogonal tests of the recognition of
+    /// section 6 (default 2); positions are compared within `2 · th_pos` mean edge lengths.
+    pub recognize_angle_degrees: f64,
     /// Rounds of face propagation for faces whose vertices belong to no compatible region
     /// (default 3).
     pub face_passes: usize,
@@ -97,6 +102,7 @@ impl Default for SegmentParams {
             simpler_floor: 0.001,
             min_cone_angle_degrees: 1.0,
             residual_seeds: true,
+            recognize_angle_degrees: 2.0,
             face_passes: 3,
         }
     }
@@ -143,6 +149,8 @@ pub struct Segmentation {
     pub mean_edge: f64,
     /// ε of equation 2 used (1/length).
     pub epsilon: f64,
+    /// Fillets, linear extrusions and surfaces of revolution (section 6, [`recognize`]).
+    pub groups: Vec<recognize::Group>,
     /// Seconds per stage: curvature, labels, seed fits, growing, faces.
     pub timings: Vec<(&'static str, f64)>,
 }
@@ -401,8 +409,14 @@ pub fn segment_mesh(
     let t = Instant::now();
     let face_surface = grow::assign_faces(mesh, topo, &owner, &regions, &tol, params.face_passes);
     let surfaces = summarise(topo, &regions, &face_surface, &areas, &ctx);
+    let groups = recognize::recognize(
+        &surfaces,
+        params.recognize_angle_degrees.to_radians(),
+        2.0 * params.th_pos * l,
+    );
     timings.push(("faces", t.elapsed().as_secs_f64()));
     Ok(Segmentation {
+        groups,
         surfaces,
         face_surface,
         vertex_surface: owner,
