@@ -209,6 +209,20 @@ fn abc_model_types_and_parameters() {
         .filter(|s| s.kind == SurfaceType::Cone)
         .count();
     assert!(cones >= 6);
+    // Section 6: the six sides form a linear extrusion; the hole, the six chamfer cones and
+    // the top and bottom planes a surface of revolution.
+    let ext: Vec<_> = seg
+        .groups
+        .iter()
+        .filter(|g| g.kind == GroupKind::Extrusion)
+        .collect();
+    assert!(ext.iter().any(|g| g.surfaces.len() == 6));
+    let rev: Vec<_> = seg
+        .groups
+        .iter()
+        .filter(|g| g.kind == GroupKind::Revolution)
+        .collect();
+    assert!(rev.iter().any(|g| g.surfaces.len() == 9));
 }
 
 #[test]

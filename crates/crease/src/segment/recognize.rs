@@ -11,8 +11,8 @@
 //! - **Linear extrusions**: topologically connected planes and cylinders with every plane
 //!   normal orthogonal to a common direction and every cylinder axis parallel to it, with at
 //!   least three planes (their normals then coplanar) or two cylinders. The candidate directions
-//!   are the cylinders' axes and the cross products of adjacent planes' normals, tried in
-//!   surface order; a surface joins at most one extrusion.
+//!   are the cylinders' axes and the cross products of adjacent planes' normals; the largest
+//!   group is taken first, then the largest among the remaining surfaces, and so on.
 //! - **Surfaces of revolution**: topologically connected planes (normal parallel to the axis),
 //!   cylinders, cones and tori (axis parallel and on the same line) and spheres (centre on the
 //!   line), at least two surfaces. Candidate axes: those of the cylinders, cones and tori in
@@ -203,39 +203,40 @@ pub fn recognize(surfaces: &[SegmentSurface], angle_tol: f64, position_tol: f64)
             _ => {}
         }
     }
-    for d in candidates {
-        let start = (0..surfaces.len()).find(|&i| !used[i] && fits_dir(&surfaces[i], d));
-        let Some(start) = start else { continue };
-        // Largest connected set of compatible, unused surfaces reachable from any start.
-        let mut best: Vec<u32> = Vec::new();
-        let mut seen = vec![false; surfaces.len()];
-        for s0 in start..surfaces.len() {
-            if seen[s0] || used[s0] || !fits_dir(&surfaces[s0], d) {
-                continue;
-            }
-            let comp = component(surfaces, s0, &mut seen, |j| {
-                !used[j] && fits_dir(&surfaces[j], d)
-            });
-            let planes = comp
-                .iter()
-                .filter(|&&j| surfaces[j as usize].kind == SurfaceType::Plane)
-                .count();
-            let cyls = comp.len() - planes;
-            if (planes >= 3 || cyls >= 2) && comp.len() > best.len() {
-                best = comp;
+    // Greedy: the direction whose group is largest first, then the next among the rest.
+    loop {
+        let mut best: (Vec<u32>, Point3) = (Vec::new(), [0.0; 3]);
+        for &d in &candidates {
+            let mut seen = vec![false; surfaces.len()];
+            for s0 in 0..surfaces.len() {
+                if seen[s0] || used[s0] || !fits_dir(&surfaces[s0], d) {
+                    continue;
+                }
+                let comp = component(surfaces, s0, &mut seen, |j| {
+                    !used[j] && fits_dir(&surfaces[j], d)
+                });
+                let planes = comp
+                    .iter()
+                    .filter(|&&j| surfaces[j as usize].kind == SurfaceType::Plane)
+                    .count();
+                let cyls = comp.len() - planes;
+                if (planes >= 3 || cyls >= 2) && comp.len() > best.0.len() {
+                    best = (comp, d);
+                }
             }
         }
-        if !best.is_empty() {
-            for &j in &best {
-                used[j as usize] = true;
-            }
-            groups.push(Group {
-                kind: GroupKind::Extrusion,
-                surfaces: best,
-                direction: d,
-                point: [0.0; 3],
-            });
+        if best.0.is_empty() {
+            break;
         }
+        for &j in &best.0 {
+            used[j as usize] = true;
+        }
+        groups.push(Group {
+            kind: GroupKind::Extrusion,
+            surfaces: best.0,
+            direction: best.1,
+            point: [0.0; 3],
+        });
     }
     // Surfaces of revolution.
     let mut used = vec![false; surfaces.len()];
