@@ -51,8 +51,8 @@ pub mod label {
 pub struct LabelParams {
     /// ε1 = ε2 = ε3 of equation 2 in units of `1 / l̄` (paper: 0.01 in 1/length).
     pub eps_edge: f64,
-    /// Upper bound of ε in units of `1 / D`... as `ε l̄ ≤ eps_diagonal · l̄ / D` (default 0.5:
-    /// radii above twice the diagonal count as flat).
+    /// Upper bound of ε relative to the bounding-box diagonal `D`: `ε ≤ eps_diagonal / D`
+    /// (default 0.5: radii above twice the diagonal count as flat, whatever the resolution).
     pub eps_diagonal: f64,
     /// Absolute ε (1/length) overriding both when set.
     pub eps_absolute: Option<f64>,
