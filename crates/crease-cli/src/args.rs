@@ -73,6 +73,9 @@ pub enum Command {
     /// Feature edges of a triangle mesh that survive noise (tangent-plane angle, Potts energy
     /// minimised by a graph cut; dihedral and hysteresis thresholding as baselines).
     Edges(crate::commands::edges::EdgesArgs),
+    /// Segment a triangle mesh into planes, cylinders, cones, spheres and tori with their
+    /// parameters (Mizoguchi et al.).
+    Segment(crate::commands::segment::SegmentArgs),
     /// Run every capability on a built-in synthetic part; no input files needed.
     Demo {
         /// Folder to write the results into.

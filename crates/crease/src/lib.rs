@@ -21,6 +21,7 @@ pub mod io;
 pub mod lines;
 pub mod meshfeat;
 pub mod render;
+pub mod segment;
 pub mod sharp;
 pub mod spatial;
 pub mod synth;

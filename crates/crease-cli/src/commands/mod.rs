@@ -10,6 +10,7 @@ mod info;
 pub(crate) mod lines;
 pub(crate) mod normals;
 mod render;
+pub(crate) mod segment;
 pub(crate) mod sharp;
 mod synth;
 
@@ -41,6 +42,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fillets(a) => fillets::run(g, &a, false),
         Command::Network(a) => fillets::run(g, &a, true),
         Command::Edges(a) => edges::run(g, &a),
+        Command::Segment(a) => segment::run(g, &a),
     }
 }
 

@@ -100,7 +100,26 @@ pub fn bezier_curvature(
     topo: &MeshTopology,
     params: &BezierParams,
 ) -> Result<BezierCurvature> {
+    bezier_curvature_with_sharp(mesh, topo, params, None)
+}
+
+/// [`bezier_curvature`] with vertices known to be sharp beforehand (e.g. on creases found by
+/// their dihedral angle): they are sharp whatever their first-pass curvature, so the second
+/// pass neither fits them nor reaches past them. `forced` has one flag per vertex.
+///
+/// Errors: as [`bezier_curvature`], or `forced` of the wrong length.
+pub fn bezier_curvature_with_sharp(
+    mesh: &TriMesh,
+    topo: &MeshTopology,
+    params: &BezierParams,
+    forced: Option<&[bool]>,
+) -> Result<BezierCurvature> {
     check(mesh, topo)?;
+    if forced.is_some_and(|f| f.len() != mesh.num_vertices()) {
+        return Err(Error::InvalidArgument(
+            "Bézier curvature: one forced-sharp flag per vertex expected".into(),
+        ));
+    }
     for (name, w) in [
         ("first width", params.first_width),
         ("second width", params.second_width),
@@ -128,7 +147,8 @@ pub fn bezier_curvature(
     let first = fit_pass(mesh, topo, &normals, params.first_width, None);
     let sharp: Vec<bool> = first
         .iter()
-        .map(|c| c.k1.abs().max(c.k2.abs()) > th_se)
+        .enumerate()
+        .map(|(i, c)| c.k1.abs().max(c.k2.abs()) > th_se || forced.is_some_and(|f| f[i]))
         .collect();
     let second = fit_pass(mesh, topo, &normals, params.second_width, Some(&sharp));
     let items: Vec<PointCurvature> = first

@@ -1,0 +1,249 @@
+//! Region growing (mizoguchi section 5.2) and the assignment of faces to the grown regions.
+//!
+//! **Growing.** Seeds are processed in descending order of their vertex count. A seed's fit
+//! (section 5.1, refined, see [`super::fit`]) is first checked against the seed itself: only
+//! the seed vertices compatible with it (equations 4 and 5) are kept, and the seed is dropped
+//! when fewer than a quarter of its free vertices (or fewer than `th_seed`) are. This check is
+//! not in the paper; it discards the seeds of mislabelled vertices (e.g. blends between two
+//! surfaces labelled torus by Step 3) before they grow, while a seed that spans two surfaces
+//! (a fillet's cylinder labels running on into the spherical corner) still grows from the part
+//! its fit explains; the rest is picked up by the residual seeds. A vertex adjacent to the region joins it when it belongs
+//! to no region yet and satisfies
+//! - equation 4: `|v_i − p(v_i)| < th_pos · l̄`, with `p(v_i)` the nearest point of the
+//!   surface (the paper projects along `n_i`; near the surface, where the test matters, both
+//!   agree to first order, and the orthogonal distance is defined everywhere);
+//! - equation 5: the angle between the vertex normal `n_i` (from the incident faces) and the
+//!   surface normal at `p(v_i)` is below `th_norm`; orientation is ignored (unsigned angle), so
+//!   the meshes need not be oriented.
+//!
+//! The paper grows once. Here the surface is refitted to the grown region and growing resumes
+//! from it with the refitted surface (the seed's fit extrapolates poorly from a small seed),
+//! then the surface is refitted a last time: the "refit" after growing.
+//!
+//! **Faces.** The output is per face. A face takes, among the regions of its three vertices,
+//! the one it agrees with best (centroid distance over `th_pos · l̄` plus normal angle over
+//! `th_norm`, both below 1); this resolves the vertices on creases, which belong to one region
+//! but whose faces lie on both sides. Faces with no compatible candidate then take, over up to
+//! `face_passes` rounds, a compatible region of an edge-adjacent face (faces whose three
+//! vertices are all on creases, common in CAD tessellations). Faces left without one keep the
+//! region holding two or three of their vertices, else -1.
+
+use crate::geometry::vec3::{dot, scale};
+use crate::geometry::{MeshTopology, Point3, TriMesh};
+use crate::synth::{SurfaceParams, SurfaceType};
+
+use super::fit::{fit, signed_distance, surface_normal, Fit};
+
+/// Tolerances of the compatibility tests.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Tol {
+    /// `th_pos · l̄` (length).
+    pub pos: f64,
+    /// cos(th_norm).
+    pub cos_norm: f64,
+}
+
+impl Tol {
+    /// Equations 4 and 5.
+    #[inline]
+    pub fn ok(&self, s: &SurfaceParams, p: Point3, n: Point3) -> bool {
+        signed_distance(s, p).abs() < self.pos && dot(surface_normal(s, p), n).abs() > self.cos_norm
+    }
+}
+
+/// Data the growing reads.
+pub(crate) struct Ctx<'a> {
+    pub topo: &'a MeshTopology,
+    pub pos: &'a [Point3],
+    /// Face-based vertex normals `n_i` (equation 5).
+    pub vnormal: &'a [Point3],
+    /// Refitted normals `n'_i` (fits).
+    pub fnormal: &'a [Point3],
+    /// Vertex weights (areas).
+    pub weight: &'a [f64],
+    pub tol: Tol,
+}
+
+impl Ctx<'_> {
+    /// Fit of `kind` to vertices `vs`.
+    pub fn fit(&self, kind: SurfaceType, vs: &[u32]) -> Option<Fit> {
+        let pts: Vec<Point3> = vs.iter().map(|&v| self.pos[v as usize]).collect();
+        let nrm: Vec<Point3> = vs.iter().map(|&v| self.fnormal[v as usize]).collect();
+        let w: Vec<f64> = vs.iter().map(|&v| self.weight[v as usize]).collect();
+        fit(kind, &pts, &nrm, &w)
+    }
+
+    /// Equations 4 and 5 for vertex `v`.
+    pub fn ok(&self, s: &SurfaceParams, v: u32) -> bool {
+        self.tol
+            .ok(s, self.pos[v as usize], self.vnormal[v as usize])
+    }
+}
+
+/// A grown region.
+#[derive(Debug, Clone)]
+pub(crate) struct Region {
+    pub kind: SurfaceType,
+    pub fit: Fit,
+    pub vertices: Vec<u32>,
+}
+
+/// Breadth-first growth of `region` (owned vertices marked with `id` in `owner`) by the
+/// compatible unowned neighbours.
+fn grow_bfs(ctx: &Ctx, s: &SurfaceParams, id: i32, region: &mut Vec<u32>, owner: &mut [i32]) {
+    let mut head = 0;
+    while head < region.len() {
+        let u = region[head] as usize;
+        head += 1;
+        for w in ctx.topo.neighbors(u) {
+            let wi = w as usize;
+            if owner[wi] == -1 && ctx.ok(s, w) {
+                owner[wi] = id;
+                region.push(w);
+            }
+        }
+    }
+}
+
+/// Grows `seed` (type, vertices, its fit) into a region with id `id`. `None` if the seed fails
+/// its own check: fewer than `min_seed` compatible vertices, or fewer than `min_core_fraction`
+/// of its vertices still free.
+pub(crate) fn grow_seed(
+    ctx: &Ctx,
+    kind: SurfaceType,
+    seed: &[u32],
+    seed_fit: Option<Fit>,
+    (min_seed, min_core_fraction): (usize, f64),
+    id: i32,
+    owner: &mut [i32],
+) -> Option<Region> {
+    let free: Vec<u32> = seed
+        .iter()
+        .copied()
+        .filter(|&v| owner[v as usize] == -1)
+        .collect();
+    if free.len() < min_seed.max(1) {
+        return None;
+    }
+    // The seed's fit stays valid when bigger regions took some of its vertices.
+    let f = match seed_fit {
+        Some(f) => f,
+        None => ctx.fit(kind, &free)?,
+    };
+    let core: Vec<u32> = free
+        .iter()
+        .copied()
+        .filter(|&v| ctx.ok(&f.params, v))
+        .collect();
+    if core.len() < min_seed.max(1) || (core.len() as f64) < min_core_fraction * free.len() as f64 {
+        return None;
+    }
+    let mut region = core;
+    for &v in &region {
+        owner[v as usize] = id;
+    }
+    grow_bfs(ctx, &f.params, id, &mut region, owner);
+    let mut f = ctx.fit(kind, &region).unwrap_or(f);
+    let before = region.len();
+    grow_bfs(ctx, &f.params, id, &mut region, owner);
+    if region.len() > before {
+        f = ctx.fit(kind, &region).unwrap_or(f);
+    }
+    Some(Region {
+        kind,
+        fit: f,
+        vertices: region,
+    })
+}
+
+/// Per-face region (see the module documentation).
+pub(crate) fn assign_faces(
+    mesh: &TriMesh,
+    topo: &MeshTopology,
+    owner: &[i32],
+    regions: &[Region],
+    tol: &Tol,
+    face_passes: usize,
+) -> Vec<i32> {
+    use rayon::prelude::*;
+    let p = mesh.positions();
+    let fnormals = topo.face_normals();
+    let score = |f: usize, r: i32| -> f64 {
+        let [a, b, c] = mesh.faces[f];
+        let cen = scale(
+            crate::geometry::vec3::add(
+                crate::geometry::vec3::add(p[a as usize], p[b as usize]),
+                p[c as usize],
+            ),
+            1.0 / 3.0,
+        );
+        let s = &regions[r as usize].fit.params;
+        let d = signed_distance(s, cen).abs() / tol.pos;
+        let cosang = dot(surface_normal(s, cen), fnormals[f]).abs().min(1.0);
+        let a = cosang.acos() / tol.cos_norm.acos().max(1e-9);
+        if d < 1.0 && a < 1.0 {
+            d + a
+        } else {
+            f64::INFINITY
+        }
+    };
+    let best = |f: usize, cands: &mut Vec<i32>| -> i32 {
+        cands.sort_unstable();
+        cands.dedup();
+        let mut best = (f64::INFINITY, -1);
+        for &r in cands.iter() {
+            if r < 0 {
+                continue;
+            }
+            let s = score(f, r);
+            if s < best.0 {
+                best = (s, r);
+            }
+        }
+        best.1
+    };
+    let mut face: Vec<i32> = (0..mesh.faces.len())
+        .into_par_iter()
+        .map(|f| {
+            let mut c: Vec<i32> = mesh.faces[f].iter().map(|&v| owner[v as usize]).collect();
+            best(f, &mut c)
+        })
+        .collect();
+    let fe = topo.face_edges();
+    for _ in 0..face_passes {
+        let next: Vec<i32> = (0..face.len())
+            .into_par_iter()
+            .map(|f| {
+                if face[f] >= 0 {
+                    return face[f];
+                }
+                let mut c = Vec::new();
+                for &e in &fe[f] {
+                    for &g in topo.edge_faces(e as usize) {
+                        if g as usize != f {
+                            c.push(face[g as usize]);
+                        }
+                    }
+                }
+                best(f, &mut c)
+            })
+            .collect();
+        let changed = next != face;
+        face = next;
+        if !changed {
+            break;
+        }
+    }
+    // Fallback: the majority region of the face's vertices.
+    face.par_iter_mut().enumerate().for_each(|(f, r)| {
+        if *r < 0 {
+            let o = mesh.faces[f].map(|v| owner[v as usize]);
+            if o[0] >= 0 && (o[0] == o[1] || o[0] == o[2]) {
+                *r = o[0];
+            } else if o[1] >= 0 && o[1] == o[2] {
+                *r = o[1];
+            }
+        }
+    });
+    face
+}

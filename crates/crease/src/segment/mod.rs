@@ -1,0 +1,482 @@
+//! Segmentation of a triangle mesh into analytic surfaces — planes, cylinders, cones, spheres
+//! and tori with their parameters — after Mizoguchi, Date, Kanai and Kishinami, "Segmentation
+//! of Scanned Mesh into Analytic Surfaces Based on Robust Curvature Estimation and Region
+//! Growing" (`mizoguchi-analytic-surface-segmentation`).
+//!
+//! Pipeline ([`segment_mesh`]):
+//! 1. two-pass Bézier curvature with sharp-vertex recognition (section 3,
+//!    [`crate::estimate::bezier`]);
+//! 2. vertex labels and seed regions (section 4, [`labels`]);
+//! 3. a fit per seed (section 5.1, [`fit`]: the paper's linear fits, then a geometric
+//!    Levenberg–Marquardt refinement);
+//! 4. region growing in descending seed size with the tolerances of equations 4 and 5, and a
+//!    refit (section 5.2, [`grow`]);
+//! 5. per-face surfaces, surface areas, RMS errors and adjacency;
+//! 6. fillets, linear extrusions and surfaces of revolution (section 6, [`recognize`]).
+//!
+//! **Model selection (an addition to the paper).** The labels of section 4 decide a seed's type
+//! in the paper. They are fragile where curvature estimates are: equation 3 tells cones from
+//! cylinders by the variation of `κ_max` over a 2-ring, which is small on both when the mesh is
+//! fine or the cone slender and noisy on irregular tessellations; on small CAD patches (the
+//! ABC model's cone chamfers) the curvature fits near the borders give neither `κ_min ≈ 0` nor
+//! equal curvatures, so the vertices end with label 0 and Step 3 calls them torus. So every seed
+//! is fitted with its label's type and with the simpler types that type can degenerate to, and
+//! the simplest one that fits about as well as the best is kept (see `SegmentParams::
+//! simpler_factor`); cones slimmer than `min_cone_angle_degrees` are not considered.
+//!
+//! Surface-type codes (PLY `surface_type`, uchar) are those of
+//! [`SurfaceType`](crate::synth::SurfaceType): plane 0, cylinder 1, cone 2, sphere 3, torus 4,
+//! 255 unassigned.
+
+pub mod fit;
+pub mod grow;
+pub mod labels;
+pub mod recognize;
+pub mod score;
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::estimate::bezier::{bezier_curvature_with_sharp, BezierParams};
+use crate::geometry::{face_areas, Aabb, MeshTopology, TriMesh};
+use crate::synth::{SurfaceParams, SurfaceType};
+use crate::{Error, Result};
+
+pub use fit::Fit;
+pub use labels::{label, LabelParams};
+
+/// Parameters of [`segment_mesh`]. `Default` = the paper's values (made scale-invariant as
+/// documented on each field).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SegmentParams {
+    /// Curvature estimation (section 3; W = 2 then 5, `th_se` relative to the edge length).
+    pub bezier: BezierParams,
+    /// Vertices on a mesh edge whose dihedral angle exceeds this (degrees) are sharp vertices
+    /// in addition to those of `th_se` (default 30). Not in the paper: on CAD tessellations the
+    /// vertices of moderate creases (45° chamfers) stay below `th_se`, and the second-pass fits
+    /// of the narrow patches between such creases reach across them (measured on the ABC model:
+    /// `κ_max l̄` of 0.17–0.29 instead of 0.02 on its chamfer cones). A smooth surface of radius
+    /// `r` has dihedral angles of about `l̄ / r` radians, so 30° only touches radii below two
+    /// edge lengths.
+    pub crease_angle_degrees: f64,
+    /// Labels and seeds (section 4).
+    pub labels: LabelParams,
+    /// `th_pos` of equation 4 in units of the mean edge length (paper: 0.5).
+    pub th_pos: f64,
+    /// `th_norm` of equation 5 in degrees (paper: 8).
+    pub th_norm_degrees: f64,
+    /// Model selection: a simpler surface type is kept when its RMS error is at most this
+    /// factor times the best candidate's (plus `simpler_floor`); default 1.5.
+    pub simpler_factor: f64,
+    /// Model selection: allowance added to the RMS bound, in mean edge lengths (default 0.001).
+    pub simpler_floor: f64,
+    /// Smallest half angle (degrees) a cone may have; slimmer ones are cylinders (default 1).
+    pub min_cone_angle_degrees: f64,
+    /// After growing, the connected sets of vertices left in no region and not on a crease
+    /// (`crease_angle_degrees`; vertices sharp by `th_se` alone take part, as fillets of a few
+    /// edges' radius on noisy meshes pass it) (at least
+    /// `th_seed` of the torus, 7) become seeds of any type and grow too, for up to three rounds
+    /// (default true). Not in
+    /// the paper: small patches whose curvature labels are spoiled by their neighbours (the
+    /// spherical corners between three fillets) get no seed of their own otherwise.
+    pub residual_seeds: bool,
+    /// Angle tolerance (degrees) of the parallel / orthogonal tests of the recognition of
+    /// section 6 (default 2); positions are compared within `2 · th_pos` mean edge lengths.
+    pub recognize_angle_degrees: f64,
+    /// Rounds of face propagation for faces whose vertices belong to no compatible region
+    /// (default 3).
+    pub face_passes: usize,
+}
+
+impl Default for SegmentParams {
+    fn default() -> Self {
+        SegmentParams {
+            bezier: BezierParams::default(),
+            crease_angle_degrees: 30.0,
+            labels: LabelParams::default(),
+            th_pos: 0.5,
+            th_norm_degrees: 8.0,
+            simpler_factor: 1.5,
+            simpler_floor: 0.001,
+            min_cone_angle_degrees: 1.0,
+            residual_seeds: true,
+            recognize_angle_degrees: 2.0,
+            face_passes: 3,
+        }
+    }
+}
+
+/// One extracted analytic surface.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SegmentSurface {
+    /// Surface id (the `surface` values).
+    pub id: u32,
+    /// Type (serialised as its lower-case name).
+    #[serde(rename = "type", serialize_with = "type_name")]
+    pub kind: SurfaceType,
+    /// Parameters (plane: normal and offset; cylinder: axis point, direction, radius; cone:
+    /// apex, axis direction from the apex into the patch, half angle in radians; sphere:
+    /// centre, radius; torus: centre, axis, major and minor radius).
+    pub params: SurfaceParams,
+    /// Total area of its faces.
+    pub area: f64,
+    /// Number of its vertices (the grown region).
+    pub vertices: usize,
+    /// Number of its faces.
+    pub faces: usize,
+    /// Area-weighted RMS of the orthogonal distances of its vertices to the surface.
+    pub rms: f64,
+    /// Ids of the surfaces sharing a mesh edge with it, ascending.
+    pub neighbours: Vec<u32>,
+}
+
+/// Result of [`segment_mesh`]. Per-vertex and per-face vectors follow the input order.
+#[derive(Debug, Clone)]
+pub struct Segmentation {
+    /// The surfaces, id = index; ordered by decreasing vertex count of their seeds' growth.
+    pub surfaces: Vec<SegmentSurface>,
+    /// Per face: surface id or -1.
+    pub face_surface: Vec<i32>,
+    /// Per vertex: surface id of the region it was grown into, or -1.
+    pub vertex_surface: Vec<i32>,
+    /// Per vertex: label of section 4 ([`label`]).
+    pub vertex_labels: Vec<u8>,
+    /// Number of seed regions.
+    pub seeds: usize,
+    /// Mean edge length `l̄`.
+    pub mean_edge: f64,
+    /// ε of equation 2 used (1/length).
+    pub epsilon: f64,
+    /// Fillets, linear extrusions and surfaces of revolution (section 6, [`recognize`]).
+    pub groups: Vec<recognize::Group>,
+    /// Seconds per stage: curvature, labels, seed fits, growing, faces.
+    pub timings: Vec<(&'static str, f64)>,
+}
+
+impl Segmentation {
+    /// Per face: the `surface_type` code (255 when unassigned).
+    pub fn face_types(&self) -> Vec<u8> {
+        self.face_surface
+            .iter()
+            .map(|&s| {
+                if s < 0 {
+                    SurfaceType::Other.code()
+                } else {
+                    self.surfaces[s as usize].kind.code()
+                }
+            })
+            .collect()
+    }
+}
+
+fn type_name<S: serde::Serializer>(t: &SurfaceType, s: S) -> std::result::Result<S::Ok, S::Error> {
+    s.serialize_str(t.name())
+}
+
+/// The fit of a seed: the simplest candidate type (plane, sphere, cylinder, cone, torus in
+/// that order) whose RMS error is at most `simpler_factor` times the best candidate's plus
+/// `simpler_floor · l̄`. Candidates: the seed's label type and the simpler types it can
+/// degenerate to (cylinder / cone seeds: plane, cylinder, cone; sphere: plane, sphere; torus:
+/// all five).
+fn select_model(
+    ctx: &grow::Ctx,
+    lab: u8,
+    vs: &[u32],
+    params: &SegmentParams,
+    min_cone: f64,
+    l: f64,
+) -> Option<(SurfaceType, Fit)> {
+    use SurfaceType as T;
+    let cands: &[T] = match lab {
+        label::PLANE => &[T::Plane],
+        label::CYLINDER | label::CONE => &[T::Plane, T::Cylinder, T::Cone],
+        label::SPHERE => &[T::Plane, T::Sphere],
+        label::TORUS => &[T::Plane, T::Sphere, T::Cylinder, T::Cone, T::Torus],
+        _ => return None,
+    };
+    // Trimmed fits: refit to the seed vertices compatible with the fit (equations 4 and 5),
+    // up to three times, so that seeds polluted by mislabelled border vertices still give
+    // the surface of their majority.
+    let fits: Vec<(T, Fit, usize)> = cands
+        .iter()
+        .filter(|&&k| vs.len() >= min_points(k))
+        .filter_map(|&k| {
+            let mut f = ctx.fit(k, vs)?;
+            let mut current: Vec<u32> = vs.to_vec();
+            for _ in 0..3 {
+                let inl: Vec<u32> = vs
+                    .iter()
+                    .copied()
+                    .filter(|&v| ctx.ok(&f.params, v))
+                    .collect();
+                if inl.len() < min_points(k).max(vs.len() / 4) {
+                    break;
+                }
+                if inl == current {
+                    break;
+                }
+                match ctx.fit(k, &inl) {
+                    Some(g) => f = g,
+                    None => break,
+                }
+                current = inl;
+            }
+            let inl = vs.iter().filter(|&&v| ctx.ok(&f.params, v)).count();
+            Some((k, f, inl))
+        })
+        .filter(|(_, f, _)| match f.params {
+            SurfaceParams::Cone { half_angle, .. } => half_angle >= min_cone,
+            _ => true,
+        })
+        .collect();
+    let best_count = fits.iter().map(|x| x.2).max()?;
+    let eligible: Vec<&(T, Fit, usize)> = fits
+        .iter()
+        .filter(|x| x.2 as f64 >= 0.9 * best_count as f64)
+        .collect();
+    let best = eligible
+        .iter()
+        .map(|(_, f, _)| f.rms)
+        .fold(f64::INFINITY, f64::min);
+    let bound = params.simpler_factor * best + params.simpler_floor * l;
+    eligible
+        .into_iter()
+        .find(|(_, f, _)| f.rms <= bound)
+        .map(|(k, f, _)| (*k, *f))
+}
+
+/// Fewest points a fit of `k` needs.
+fn min_points(k: SurfaceType) -> usize {
+    match k {
+        SurfaceType::Plane => 2,
+        SurfaceType::Cylinder | SurfaceType::Cone => 4,
+        SurfaceType::Sphere => 4,
+        SurfaceType::Torus | SurfaceType::Other => 7,
+    }
+}
+
+/// Segments `mesh` into analytic surfaces (see the module documentation).
+///
+/// Inputs: a triangle mesh and its topology (same vertex count).
+/// Output: per-face and per-vertex surface ids and the surfaces with their parameters,
+/// identical whatever the thread count.
+/// Errors: topology of another mesh, invalid parameters, a mesh without edges.
+pub fn segment_mesh(
+    mesh: &TriMesh,
+    topo: &MeshTopology,
+    params: &SegmentParams,
+) -> Result<Segmentation> {
+    if !(params.th_pos > 0.0
+        && params.th_pos.is_finite()
+        && params.th_norm_degrees > 0.0
+        && params.th_norm_degrees < 90.0)
+    {
+        return Err(Error::InvalidArgument(format!(
+            "segmentation: th_pos must be positive and th_norm in (0, 90) degrees, got {} and {}",
+            params.th_pos, params.th_norm_degrees
+        )));
+    }
+    let mut timings = Vec::new();
+    let t = Instant::now();
+    // Vertices on creases of dihedral angle above `crease_angle_degrees` are sharp too.
+    let dihedral = topo.dihedral_angles();
+    let crease = params.crease_angle_degrees.to_radians();
+    let forced: Vec<bool> = (0..mesh.num_vertices())
+        .into_par_iter()
+        .map(|v| {
+            topo.vertex_edges(v)
+                .iter()
+                .any(|&e| dihedral[e as usize] > crease)
+        })
+        .collect();
+    let bez = bezier_curvature_with_sharp(mesh, topo, &params.bezier, Some(&forced))?;
+    timings.push(("curvature", t.elapsed().as_secs_f64()));
+    let t = Instant::now();
+    let nv = mesh.num_vertices();
+    let l = bez.mean_edge;
+    let diag = Aabb::from_points(mesh.positions())
+        .map(|b| b.diagonal())
+        .filter(|d| *d > 0.0)
+        .ok_or_else(|| Error::InvalidInput("segmentation: the mesh has no extent".into()))?;
+    let eps = params.labels.epsilon(l, diag);
+    let c = &bez.curvature;
+    let (kmax, kmin): (Vec<f64>, Vec<f64>) =
+        c.k1.iter()
+            .zip(&c.k2)
+            .map(|(&a, &b)| if a.abs() >= b.abs() { (a, b) } else { (b, a) })
+            .unzip();
+    let vertex_labels =
+        labels::vertex_labels(&kmax, &kmin, &bez.sharp, topo, eps, l, &params.labels);
+    let seeds = labels::seed_regions(&vertex_labels, topo, &params.labels);
+    timings.push(("labels", t.elapsed().as_secs_f64()));
+
+    // Vertex normals n_i (equation 5) and weights (a third of the incident faces' areas).
+    let t = Instant::now();
+    let vnormal = crate::estimate::mesh_vertex_normals(mesh, crate::estimate::Weighting::Area)?;
+    let areas = face_areas(mesh);
+    let weight: Vec<f64> = (0..nv)
+        .into_par_iter()
+        .map(|v| {
+            let a: f64 = topo
+                .vertex_faces(v)
+                .iter()
+                .map(|&f| areas[f as usize])
+                .filter(|a| a.is_finite())
+                .sum::<f64>()
+                / 3.0;
+            // Isolated or degenerate vertices still count a little.
+            a.max(1e-12 * l * l)
+        })
+        .collect();
+    let tol = grow::Tol {
+        pos: params.th_pos * l,
+        cos_norm: params.th_norm_degrees.to_radians().cos(),
+    };
+    let ctx = grow::Ctx {
+        topo,
+        pos: mesh.positions(),
+        vnormal: &vnormal,
+        fnormal: &c.normal,
+        weight: &weight,
+        tol,
+    };
+    // Seed fits, with the model selection.
+    let min_cone = params.min_cone_angle_degrees.to_radians();
+    let fitted: Vec<Option<(SurfaceType, Fit)>> = seeds
+        .par_iter()
+        .map(|(lab, vs)| select_model(&ctx, *lab, vs, params, min_cone, l))
+        .collect();
+    timings.push(("seed fits", t.elapsed().as_secs_f64()));
+
+    // Growing in descending seed size (ties: seed order).
+    let t = Instant::now();
+    let mut order: Vec<usize> = (0..seeds.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(seeds[i].1.len()));
+    let mut owner = vec![-1i32; nv];
+    let mut regions: Vec<grow::Region> = Vec::new();
+    for i in order {
+        let Some((kind, f)) = fitted[i] else { continue };
+        let (lab, vs) = &seeds[i];
+        let min_seed = params.labels.seed_size(*lab);
+        if let Some(r) = grow::grow_seed(
+            &ctx,
+            kind,
+            vs,
+            Some(f),
+            (min_seed, 0.25),
+            regions.len() as i32,
+            &mut owner,
+        ) {
+            regions.push(r);
+        }
+    }
+    // Residual seeds: connected sets of vertices no region took.
+    if params.residual_seeds {
+        let min = params.labels.seed_size(label::TORUS);
+        for _round in 0..3 {
+            let mut unowned = vec![label::OTHER; nv];
+            for v in 0..nv {
+                if owner[v] == -1 && !forced[v] {
+                    unowned[v] = label::TORUS;
+                }
+            }
+            let mut rest = labels::seed_regions(&unowned, topo, &params.labels);
+            rest.retain(|(_, vs)| vs.len() >= min);
+            rest.sort_by_key(|(_, vs)| std::cmp::Reverse(vs.len()));
+            let fitted: Vec<Option<(SurfaceType, Fit)>> = rest
+                .par_iter()
+                .map(|(lab, vs)| select_model(&ctx, *lab, vs, params, min_cone, l))
+                .collect();
+            let before = regions.len();
+            for ((_, vs), f) in rest.iter().zip(fitted) {
+                let Some((kind, f)) = f else { continue };
+                let id = regions.len() as i32;
+                if let Some(r) =
+                    grow::grow_seed(&ctx, kind, vs, Some(f), (min, 0.25), id, &mut owner)
+                {
+                    regions.push(r);
+                }
+            }
+            if regions.len() == before {
+                break;
+            }
+        }
+    }
+    timings.push(("growing", t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
+    let face_surface = grow::assign_faces(mesh, topo, &owner, &regions, &tol, params.face_passes);
+    let surfaces = summarise(topo, &regions, &face_surface, &areas, &ctx);
+    let groups = recognize::recognize(
+        &surfaces,
+        params.recognize_angle_degrees.to_radians(),
+        2.0 * params.th_pos * l,
+    );
+    timings.push(("faces", t.elapsed().as_secs_f64()));
+    Ok(Segmentation {
+        groups,
+        surfaces,
+        face_surface,
+        vertex_surface: owner,
+        vertex_labels,
+        seeds: seeds.len(),
+        mean_edge: l,
+        epsilon: eps,
+        timings,
+    })
+}
+
+/// Areas, counts, RMS errors and adjacency of the regions.
+fn summarise(
+    topo: &MeshTopology,
+    regions: &[grow::Region],
+    face_surface: &[i32],
+    areas: &[f64],
+    ctx: &grow::Ctx,
+) -> Vec<SegmentSurface> {
+    let n = regions.len();
+    let mut area = vec![0.0; n];
+    let mut faces = vec![0usize; n];
+    for (f, &s) in face_surface.iter().enumerate() {
+        if s >= 0 && areas[f].is_finite() {
+            area[s as usize] += areas[f];
+            faces[s as usize] += 1;
+        }
+    }
+    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for e in 0..topo.num_edges() {
+        let fs = topo.edge_faces(e);
+        for (i, &a) in fs.iter().enumerate() {
+            for &b in &fs[i + 1..] {
+                let (sa, sb) = (face_surface[a as usize], face_surface[b as usize]);
+                if sa >= 0 && sb >= 0 && sa != sb {
+                    adj[sa as usize].push(sb as u32);
+                    adj[sb as usize].push(sa as u32);
+                }
+            }
+        }
+    }
+    regions
+        .par_iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let pts: Vec<_> = r.vertices.iter().map(|&v| ctx.pos[v as usize]).collect();
+            let w: Vec<_> = r.vertices.iter().map(|&v| ctx.weight[v as usize]).collect();
+            let mut nb = adj[i].clone();
+            nb.sort_unstable();
+            nb.dedup();
+            SegmentSurface {
+                id: i as u32,
+                kind: r.kind,
+                params: r.fit.params,
+                area: area[i],
+                vertices: r.vertices.len(),
+                faces: faces[i],
+                rms: fit::rms_distance(&r.fit.params, &pts, &w),
+                neighbours: nb,
+            }
+        })
+        .collect()
+}
