@@ -373,4 +373,12 @@ fn demo_writes_its_results() {
     assert_eq!(net["smooth_polylines"], 2, "{net}");
     assert_eq!(net["joined_smooth_ends"], 4, "{net}");
     assert!(net["sharp_polylines"].as_u64().unwrap() >= 10, "{net}");
+    // The mesh segmented into its 10 analytic surfaces: 8 planes, the fillet's cylinder and
+    // the cone, every face assigned.
+    let seg = &v["segmentation"];
+    assert_eq!(seg["surfaces"], 10, "{seg}");
+    assert_eq!(seg["types"]["plane"], 8, "{seg}");
+    assert_eq!(seg["types"]["cylinder"], 1, "{seg}");
+    assert_eq!(seg["types"]["cone"], 1, "{seg}");
+    assert_eq!(seg["unassigned_faces"], 0, "{seg}");
 }
