@@ -166,7 +166,8 @@ pub struct ThresholdReport {
     pub contrast: f64,
     /// Whether it was used for lines.
     pub accepted: bool,
-    /// Points above τ.
+    /// Points above τ (this and the other label counts are 0 for a rejected split: the labels
+    /// are computed for the accepted ones only).
     pub high: usize,
     /// Inner, border and noisy points.
     pub inner: usize,
@@ -175,7 +176,8 @@ pub struct ThresholdReport {
     /// Noisy points.
     pub noisy: usize,
     /// Interiors (largest connected sets of points whose whole 1-ring is in the band) of the
-    /// examined interval's bands below and above τ ([`labels::band_interior`]).
+    /// examined interval's bands below and above τ ([`labels::band_interior`]; 0 when a
+    /// cheaper test already rejected the split).
     pub band_interiors: [usize; 2],
     /// Polylines and closed loops found with it.
     pub polylines: usize,
@@ -659,6 +661,10 @@ fn examine(
     first
 }
 
+/// Examines the split `split` of the interval `range`: the histogram tests first, then the
+/// contrast of the medians, then the band interiors (each only when the cheaper ones pass), and
+/// the labels only for an accepted split. Labels of a split taken anyway (a count or values
+/// forced by the user) come from [`with_labels`].
 fn candidate(
     values: &[f64],
     split: Split,
@@ -666,30 +672,47 @@ fn candidate(
     adjacency: &Csr,
     params: &FilletParams,
 ) -> Candidate {
-    let labels = labels::label(values, split.tau, adjacency);
-    let interiors = [
-        labels::band_interior(values, range[0], split.tau, adjacency),
-        labels::band_interior(values, split.tau, range[1], adjacency),
-    ];
+    let min_patch = INTERIOR_FACTOR * params.curvature_k;
+    let mut c = Candidate {
+        split,
+        labels: Vec::new(),
+        interiors: [0, 0],
+        contrast: 0.0,
+        accepted: false,
+        range,
+    };
+    if !(split.ratio >= MIN_RATIO
+        && split.right_ratio() >= MIN_RIGHT_RATIO
+        && split.b1.min(split.b3) >= min_patch as u64)
+    {
+        return c;
+    }
     let medians = [
         band_median(values, range[0], split.tau),
         band_median(values, split.tau, range[1]),
     ];
-    let contrast = (medians[1] - medians[0]) / medians[1].abs().max(f64::MIN_POSITIVE);
-    let min_patch = INTERIOR_FACTOR * params.curvature_k;
-    let accepted = split.ratio >= MIN_RATIO
-        && split.right_ratio() >= MIN_RIGHT_RATIO
-        && split.b1.min(split.b3) >= min_patch as u64
-        && contrast >= MIN_CONTRAST
-        && interiors.iter().all(|&s| s >= min_patch);
-    Candidate {
-        split,
-        labels,
-        interiors,
-        contrast,
-        accepted,
-        range,
+    c.contrast = (medians[1] - medians[0]) / medians[1].abs().max(f64::MIN_POSITIVE);
+    if c.contrast.is_nan() || c.contrast < MIN_CONTRAST {
+        return c;
     }
+    c.interiors = [
+        labels::band_interior(values, range[0], split.tau, adjacency),
+        labels::band_interior(values, split.tau, range[1], adjacency),
+    ];
+    c.accepted = c.interiors.iter().all(|&s| s >= min_patch);
+    if c.accepted {
+        c.labels = labels::label(values, split.tau, adjacency);
+    }
+    c
+}
+
+/// `c` accepted, with its labels.
+fn with_labels(mut c: Candidate, values: &[f64], adjacency: &Csr) -> Candidate {
+    if c.labels.is_empty() {
+        c.labels = labels::label(values, c.split.tau, adjacency);
+    }
+    c.accepted = true;
+    c
 }
 
 /// |H| of every point of a region: quadric fit over its `k` nearest neighbours in the region,
@@ -725,15 +748,14 @@ fn select_thresholds(values: &[f64], adj: &Csr, params: &FilletParams) -> Select
                     b2: 0,
                     b3: 0,
                 };
-                let mut c = candidate(
+                let c = candidate(
                     values,
                     split,
                     [f64::NEG_INFINITY, f64::INFINITY],
                     adj,
                     params,
                 );
-                c.accepted = true;
-                chosen.push(c);
+                chosen.push(with_labels(c, values, adj));
             }
         }
         ThresholdCount::Auto { max } => {
@@ -776,8 +798,7 @@ fn select_thresholds(values: &[f64], adj: &Csr, params: &FilletParams) -> Select
                             .then(b.cmp(&a))
                     })
                     .unwrap_or(0);
-                let mut c = open.swap_remove(best);
-                c.accepted = true;
+                let c = with_labels(open.swap_remove(best), values, adj);
                 for r in [[c.range[0], c.split.tau], [c.split.tau, c.range[1]]] {
                     if let Some(next) = examine(values, (lo, hi), r, adj, params) {
                         open.push(next);
