@@ -393,22 +393,27 @@ pub fn extract_fillets(
         sharp,
         seconds,
     };
+    let mut owner_of_point = vec![u32::MAX; n];
+    let mut local_index = vec![u32::MAX; n];
+    for (c, ids) in members.iter().enumerate() {
+        for (k, &i) in ids.iter().enumerate() {
+            owner_of_point[i as usize] = c as u32;
+            local_index[i as usize] = k as u32;
+        }
+    }
+    let shared = Shared {
+        adjacency: &first.adjacency,
+        owner: &owner_of_point,
+        local: &local_index,
+        cloud_boundary: params.lines.boundary.then_some(first.boundary.as_slice()),
+    };
     for (c, ids) in members.iter().enumerate() {
         let size = ids.len();
         if (seg.sizes[c] as f64) < mean || size < min_points {
             continue;
         }
         let region_id = out.regions.len() as u32;
-        let cloud_boundary = params.lines.boundary.then_some(first.boundary.as_slice());
-        let report = process_region(
-            points,
-            ids,
-            &first.adjacency,
-            cloud_boundary,
-            params,
-            &mut out,
-            region_id,
-        )?;
+        let report = process_region(points, ids, c as u32, &shared, params, &mut out, region_id)?;
         out.regions.push(RegionReport {
             cluster: c as u32,
             ..report
@@ -497,12 +502,20 @@ fn island_owners(
         .collect()
 }
 
-/// The region's adjacency in local indices (neighbours outside the region dropped).
-fn local_adjacency(ids: &[u32], adjacency: &Csr, n: usize) -> Csr {
-    let mut local = vec![u32::MAX; n];
-    for (k, &i) in ids.iter().enumerate() {
-        local[i as usize] = k as u32;
-    }
+/// What every region reads of the whole cloud: the 1-ring adjacency, the smooth region
+/// (first-order cluster) each point belongs to and its index within that region, and the cloud's
+/// boundary flags.
+struct Shared<'a> {
+    adjacency: &'a Csr,
+    owner: &'a [u32],
+    local: &'a [u32],
+    cloud_boundary: Option<&'a [bool]>,
+}
+
+/// The adjacency of region `cluster` (points `ids`) in local indices: neighbours outside the
+/// region dropped.
+fn local_adjacency(ids: &[u32], cluster: u32, shared: &Shared) -> Csr {
+    let adjacency = shared.adjacency;
     let rows: Vec<Vec<u32>> = ids
         .par_iter()
         .map(|&i| {
@@ -512,8 +525,8 @@ fn local_adjacency(ids: &[u32], adjacency: &Csr, n: usize) -> Csr {
             adjacency
                 .row(i as usize)
                 .iter()
-                .map(|&q| local[q as usize])
-                .filter(|&q| q != u32::MAX)
+                .filter(|&&q| shared.owner[q as usize] == cluster)
+                .map(|&q| shared.local[q as usize])
                 .collect()
         })
         .collect();
@@ -812,18 +825,17 @@ fn select_thresholds(values: &[f64], adj: &Csr, params: &FilletParams) -> Select
     (lo, hi, chosen, rejected)
 }
 
-#[allow(clippy::too_many_arguments)]
 fn process_region(
     points: &[Point3],
     ids: &[u32],
-    adjacency: &Csr,
-    cloud_boundary: Option<&[bool]>,
+    cluster: u32,
+    shared: &Shared,
     params: &FilletParams,
     out: &mut Fillets,
     region_id: u32,
 ) -> Result<RegionReport> {
     let t = Instant::now();
-    let adj = local_adjacency(ids, adjacency, points.len());
+    let adj = local_adjacency(ids, cluster, shared);
     let original: Vec<Point3> = ids.iter().map(|&i| points[i as usize]).collect();
     let smoothed = taubin(&original, &adj, params.smoothing_iterations);
     let mut values = region_curvature(&smoothed, params.curvature_k, params.median_iterations)?;
@@ -882,20 +894,16 @@ fn process_region(
     // to a sharp-edge band, plus the cloud's boundary) joins each graph as the cloud boundary
     // does in demarsin2007 (Fig. 8 of demarsin2008): a fillet line that ends at a sharp edge
     // is closed through it instead of being pruned as a dangling branch.
-    let mut in_region = vec![false; points.len()];
-    for &i in ids {
-        in_region[i as usize] = true;
-    }
+    // A point with a neighbour outside the region has a shorter local row.
     let region_boundary: Vec<bool> = ids
         .iter()
-        .map(|&i| {
+        .enumerate()
+        .map(|(k, &i)| {
             let i = i as usize;
-            cloud_boundary.is_some_and(|b| b[i])
-                || (i < adjacency.num_rows()
-                    && adjacency.row(i).iter().any(|&q| !in_region[q as usize]))
+            shared.cloud_boundary.is_some_and(|b| b[i])
+                || (i < shared.adjacency.num_rows() && adj.row_len(k) < shared.adjacency.row_len(i))
         })
         .collect();
-    drop(in_region);
     let mut thresholds = Vec::new();
     for c in &chosen {
         let seg = labels::grow(&c.labels, &adj);

@@ -53,6 +53,14 @@ pub struct Fit {
     pub rms: f64,
 }
 
+/// Coordinates `[ρ, h]` of `p` in the meridian half-plane of the axis through `origin` along
+/// the unit `dir`: distance from the axis and height along it.
+pub fn meridian(p: Point3, origin: Point3, dir: Point3) -> [f64; 2] {
+    let v = sub(p, origin);
+    let h = dot(v, dir);
+    [(dot(v, v) - h * h).max(0.0).sqrt(), h]
+}
+
 /// Signed orthogonal distance from `p` to the surface (positive on the side the surface's
 /// normal of [`surface_normal`] points to). For the cone, the distance to the double cone's
 /// generator line in the meridian half-plane (exact near the patch).
@@ -63,20 +71,14 @@ pub fn signed_distance(s: &SurfaceParams, p: Point3) -> f64 {
             axis_point,
             axis_dir,
             radius,
-        } => {
-            let v = sub(p, axis_point);
-            let h = dot(v, axis_dir);
-            (dot(v, v) - h * h).max(0.0).sqrt() - radius
-        }
+        } => meridian(p, axis_point, axis_dir)[0] - radius,
         SurfaceParams::Sphere { center, radius } => norm(sub(p, center)) - radius,
         SurfaceParams::Cone {
             apex,
             axis_dir,
             half_angle,
         } => {
-            let v = sub(p, apex);
-            let h = dot(v, axis_dir);
-            let rho = (dot(v, v) - h * h).max(0.0).sqrt();
+            let [rho, h] = meridian(p, apex, axis_dir);
             let (s, c) = half_angle.sin_cos();
             rho * c - h * s
         }
@@ -86,9 +88,7 @@ pub fn signed_distance(s: &SurfaceParams, p: Point3) -> f64 {
             major_radius,
             minor_radius,
         } => {
-            let v = sub(p, center);
-            let h = dot(v, axis_dir);
-            let rho = (dot(v, v) - h * h).max(0.0).sqrt();
+            let [rho, h] = meridian(p, center, axis_dir);
             (rho - major_radius).hypot(h) - minor_radius
         }
     }
@@ -355,14 +355,7 @@ pub fn cone_linear(pts: &[Point3], nrm: &[Point3], w: &[f64]) -> Option<SurfaceP
 /// paper's Gaussian-sphere axis on narrow patches, whose normals span a short arc.
 pub fn cone_revolution(pts: &[Point3], nrm: &[Point3], w: &[f64]) -> Option<SurfaceParams> {
     let (mut d, a) = revolution_axis(pts, nrm, w)?;
-    let rh: Vec<[f64; 2]> = pts
-        .iter()
-        .map(|&p| {
-            let v = sub(p, a);
-            let h = dot(v, d);
-            [(dot(v, v) - h * h).max(0.0).sqrt(), h]
-        })
-        .collect();
+    let rh: Vec<[f64; 2]> = pts.iter().map(|&p| meridian(p, a, d)).collect();
     // Total least-squares line through the (ρ, h) points.
     let ws: f64 = w.iter().sum();
     let mr = rh.iter().zip(w).map(|(q, w)| q[0] * w).sum::<f64>() / ws;
@@ -436,14 +429,7 @@ pub fn revolution_axis(pts: &[Point3], nrm: &[Point3], w: &[f64]) -> Option<(Poi
 /// Torus (paper): Kós axis, then a circle in the meridian half-plane.
 pub fn torus_linear(pts: &[Point3], nrm: &[Point3], w: &[f64]) -> Option<SurfaceParams> {
     let (d, a) = revolution_axis(pts, nrm, w)?;
-    let rh: Vec<[f64; 2]> = pts
-        .iter()
-        .map(|&p| {
-            let v = sub(p, a);
-            let h = dot(v, d);
-            [(dot(v, v) - h * h).max(0.0).sqrt(), h]
-        })
-        .collect();
+    let rh: Vec<[f64; 2]> = pts.iter().map(|&p| meridian(p, a, d)).collect();
     let (c, r) = circle_2d(&rh, w)?;
     (c[0] > 0.0).then(|| SurfaceParams::Torus {
         center: add(a, scale(d, c[1])),
