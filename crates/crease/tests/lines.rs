@@ -75,12 +75,11 @@ fn report(name: &str, noise: f64, part: &SyntheticPart, net: &LineNetwork) -> (V
     (cover, far)
 }
 
-/// The cube: 12 edges meeting at 8 corners. Measured (20k points): with 1, 6 and 10 % noise
-/// (of the spacing) 12 polylines, 8 junctions, no endpoint, every edge covered; after the
-/// smoothing every vertex lies within 0.09 / 0.19 / 1.44 spacings of an edge (2.4 before). Noiseless, one edge is lost: near two corners the spanning
-/// tree joins it through a short parallel spur, the connect step finds no partner for the
-/// spur's end among its n nearest vertices and the pruning removes the spur with the edge
-/// (9 polylines, 6 junctions; an open problem of the closing step).
+/// The cube: 12 edges meeting at 8 corners. Measured (20k points): noiseless and with 1, 6 and
+/// 10 % noise (of the spacing) 12 polylines, 8 junctions, no endpoint, every edge covered;
+/// after the smoothing every vertex lies within 0.11 / 0.09 / 0.19 / 1.44 spacings of an edge
+/// (2.4 before). Before the direction-aware connect step (see `graph::close`) the noiseless
+/// cube lost an edge whose gap to its corner was longer than the n nearest vertices reach.
 #[test]
 fn cube_lines() {
     for noise in [0.0, 0.01, 0.06, 0.1] {
@@ -91,23 +90,17 @@ fn cube_lines() {
         assert_eq!(net.endpoints(), 0, "closed lines have no endpoints");
         let max_far = if noise <= 0.06 { 0.3 } else { 2.0 };
         assert!(far <= max_far * p.spacing, "farthest vertex {far}");
-        let covered = cover.iter().filter(|&&c| c >= 0.98).count();
-        if noise > 0.0 {
-            assert_eq!(covered, 12);
-            assert_eq!(net.junctions(), 8);
-            assert_eq!(net.polylines.len(), 12);
-        } else {
-            assert!(covered >= 11, "{cover:?}");
-        }
+        assert!(cover.iter().all(|&c| c >= 0.98), "{cover:?}");
+        assert_eq!(net.junctions(), 8);
+        assert_eq!(net.polylines.len(), 12);
     }
 }
 
 /// Two intersecting cylinders (the paper's running example): the two intersection curves and
-/// the four rims, six closed loops. Measured (30k points): noiseless and 1 % noise: 6 closed
-/// loops, no junction, no endpoint, all curves covered, smoothed vertices within 0.56
-/// spacings of the exact curves (2.4 before smoothing); 6 %
-/// noise: all curves covered, no endpoint, but one spurious link (8 polylines, 2 junctions,
-/// farthest vertex 13 spacings).
+/// the four rims, six closed loops. Measured (30k points): noiseless, 1 % and 6 % noise: 6
+/// closed loops, no junction, no endpoint, all curves covered, smoothed vertices within 0.56 /
+/// 0.51 / 0.60 spacings of the exact curves (2.4 before smoothing). Before the
+/// direction-aware connect step, 6 % noise gave one spurious link (2 junctions).
 #[test]
 fn two_cylinders_lines() {
     for noise in [0.0, 0.01, 0.06] {
@@ -116,11 +109,34 @@ fn two_cylinders_lines() {
         let (cover, far) = report("two-cylinders", noise, &p, &net);
         assert!(cover.iter().all(|&c| c >= 0.98), "{cover:?}");
         assert_eq!(net.endpoints(), 0);
-        if noise <= 0.01 {
-            assert_eq!(net.closed_loops(), 6);
-            assert_eq!(net.junctions(), 0);
-            assert!(far <= 0.7 * p.spacing, "farthest vertex {far}");
-        }
+        assert_eq!(net.closed_loops(), 6);
+        assert_eq!(net.junctions(), 0);
+        assert!(far <= 0.7 * p.spacing, "farthest vertex {far}");
+    }
+}
+
+/// The other synthetic parts with sharp curves, at 20k points and 1 % and 5 % noise: the box
+/// with a hole (12 box edges meeting at 8 corners plus the two hole rims: 14 polylines, 2
+/// closed loops, 8 junctions) and the part with a fillet, a chamfer and a cone (14 polylines,
+/// 2 closed loops, 8 junctions). Measured with `cargo run --release -p crease --example
+/// lines_synth`: exactly those counts, no endpoint, every sharp curve covered (the weakest
+/// 0.92 on the chamfer's upper line at 5 %).
+#[test]
+fn box_hole_and_chamfer_part_lines() {
+    for (name, noise) in [
+        ("box-hole", 0.01),
+        ("box-hole", 0.05),
+        ("fillet-chamfer-cone", 0.01),
+        ("fillet-chamfer-cone", 0.05),
+    ] {
+        let p = part(name, 20_000, noise);
+        let net = extract_lines(&p.cloud.positions, &LinesParams::default()).expect("lines");
+        let (cover, _) = report(name, noise, &p, &net);
+        assert!(cover.iter().all(|&c| c >= 0.9), "{name} {noise}: {cover:?}");
+        assert_eq!(net.endpoints(), 0);
+        assert_eq!(net.polylines.len(), 14, "{name} {noise}");
+        assert_eq!(net.closed_loops(), 2, "{name} {noise}");
+        assert_eq!(net.junctions(), 8, "{name} {noise}");
     }
 }
 
