@@ -87,6 +87,7 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
         d: a.d,
         smooth: !a.no_smooth,
         boundary: !a.no_boundary,
+        ..Default::default()
     };
     let start = Instant::now();
     let stage = Stage::start("sharp lines (Demarsin 2007)", g.quiet);

@@ -67,6 +67,9 @@ pub struct LinesParams {
     pub smooth: bool,
     /// Include the cloud's boundary in the network (Fig. 9); default true.
     pub boundary: bool,
+    /// Feature-preserving smoothing of the 1-ring normals before the region growing, scaled
+    /// to the measured normal noise (see [`first_order`]); default true. Not in the paper.
+    pub denoise_normals: bool,
 }
 
 impl Default for LinesParams {
@@ -79,6 +82,7 @@ impl Default for LinesParams {
             d: None,
             smooth: true,
             boundary: true,
+            denoise_normals: true,
         }
     }
 }
@@ -180,6 +184,18 @@ pub struct FirstOrder {
     pub seconds: f64,
 }
 
+/// The normals are smoothed when their median adjacent angle exceeds this fraction of α_max.
+const DENOISE_START: f64 = 0.75;
+
+/// Smoothing stops once the median adjacent angle is at most this fraction of α_max.
+const DENOISE_STOP: f64 = 0.25;
+
+/// σ of the bilateral weights, relative to the current median adjacent angle.
+const DENOISE_SIGMA: f64 = 1.5;
+
+/// At most this many passes of the bilateral normal smoothing.
+const DENOISE_PASSES: usize = 6;
+
 fn check_params(params: &LinesParams) -> Result<()> {
     if !(params.alpha_max_degrees > 0.0 && params.alpha_max_degrees < 90.0) {
         return Err(Error::InvalidArgument(format!(
@@ -199,7 +215,21 @@ fn check_params(params: &LinesParams) -> Result<()> {
 /// Step 1 (section 2.2): Delaunay 1-rings of the `params.k` nearest neighbours, their normals,
 /// and region growing with `params.alpha_max_degrees`.
 ///
-/// Errors: fewer than k + 1 points, non-finite coordinates, invalid parameters.
+/// **Noisy clouds (an addition to the paper).** A 1-ring holds about six points, so its
+/// least-squares normal follows the noise: with Gaussian noise of 20 % of the spacing along the
+/// normal, adjacent 1-ring normals on a flat face differ by 11° at the median (measured on the
+/// synthetic parts: 0° without noise, 2.7° at 5 %, 5.5° at 10 %, 17° at 30 %), more than
+/// α_max = 8°, and the region growing shatters the faces into thousands of small clusters
+/// (at 20 %: 160 to 290 polylines instead of 6 to 14). With `params.denoise_normals`, when the
+/// median adjacent angle exceeds 0.75 α_max, the normals are smoothed by bilateral passes
+/// ([`segment::smooth_normals`], σ = 1.5 × the current median angle) until that median is at
+/// most α_max / 4 (at most 6 passes). Normals across a 90° edge differ by about 45° per step
+/// and keep a weight below exp(−4), so the edges stay; shallow creases are blurred, which is
+/// why clouds quiet enough for the plain region growing (10 % noise and less) are left as they
+/// are. Measured with `examples/lines_synth.rs` at 20 %: the cube and the box with a hole give
+/// their exact networks, the two cylinders 6 loops plus one spurious link, the
+/// fillet-chamfer-cone part every curve at 91 % or more with 4 extra polylines. σ = 2 smooths
+/// the cube and the box exactly even at 30 % but erases the 45° chamfer lines at 20 %.
 pub fn first_order(points: &[Point3], params: &LinesParams) -> Result<FirstOrder> {
     check_params(params)?;
     let t = Instant::now();
@@ -208,6 +238,20 @@ pub fn first_order(points: &[Point3], params: &LinesParams) -> Result<FirstOrder
     drop(nbrs);
     let normals = ring_normals(points, &rings);
     let adjacency = rings.symmetrized();
+    let mut normals = normals;
+    if params.denoise_normals {
+        let alpha = params.alpha_max_degrees.to_radians();
+        let mut noise = segment::median_adjacent_angle(&normals, &adjacency);
+        if noise > DENOISE_START * alpha {
+            for _ in 0..DENOISE_PASSES {
+                normals = segment::smooth_normals(&normals, &adjacency, DENOISE_SIGMA * noise, 1);
+                noise = segment::median_adjacent_angle(&normals, &adjacency);
+                if noise <= DENOISE_STOP * alpha {
+                    break;
+                }
+            }
+        }
+    }
     let boundary = rings.boundary.clone();
     drop(rings);
     let segmentation = region_grow(&normals, &adjacency, params.alpha_max_degrees.to_radians());
