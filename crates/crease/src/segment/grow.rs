@@ -30,6 +30,7 @@
 
 use crate::geometry::vec3::{dot, scale};
 use crate::geometry::{MeshTopology, Point3, TriMesh};
+use crate::spatial::Adjacency;
 use crate::synth::{SurfaceParams, SurfaceType};
 
 use super::fit::{fit, signed_distance, surface_normal, Fit};
@@ -52,8 +53,8 @@ impl Tol {
 }
 
 /// Data the growing reads.
-pub(crate) struct Ctx<'a> {
-    pub topo: &'a MeshTopology,
+pub(crate) struct Ctx<'a, G: Adjacency> {
+    pub topo: &'a G,
     pub pos: &'a [Point3],
     /// Face-based vertex normals `n_i` (equation 5).
     pub vnormal: &'a [Point3],
@@ -64,7 +65,7 @@ pub(crate) struct Ctx<'a> {
     pub tol: Tol,
 }
 
-impl Ctx<'_> {
+impl<G: Adjacency> Ctx<'_, G> {
     /// Fit of `kind` to vertices `vs`.
     pub fn fit(&self, kind: SurfaceType, vs: &[u32]) -> Option<Fit> {
         let pts: Vec<Point3> = vs.iter().map(|&v| self.pos[v as usize]).collect();
@@ -90,26 +91,32 @@ pub(crate) struct Region {
 
 /// Breadth-first growth of `region` (owned vertices marked with `id` in `owner`) by the
 /// compatible unowned neighbours.
-fn grow_bfs(ctx: &Ctx, s: &SurfaceParams, id: i32, region: &mut Vec<u32>, owner: &mut [i32]) {
+fn grow_bfs<G: Adjacency>(
+    ctx: &Ctx<G>,
+    s: &SurfaceParams,
+    id: i32,
+    region: &mut Vec<u32>,
+    owner: &mut [i32],
+) {
     let mut head = 0;
     while head < region.len() {
         let u = region[head] as usize;
         head += 1;
-        for w in ctx.topo.neighbors(u) {
+        ctx.topo.for_each_neighbor(u, |w| {
             let wi = w as usize;
             if owner[wi] == -1 && ctx.ok(s, w) {
                 owner[wi] = id;
                 region.push(w);
             }
-        }
+        });
     }
 }
 
 /// Grows `seed` (type, vertices, its fit) into a region with id `id`. `None` if the seed fails
 /// its own check: fewer than `min_seed` compatible vertices, or fewer than `min_core_fraction`
 /// of its vertices still free.
-pub(crate) fn grow_seed(
-    ctx: &Ctx,
+pub(crate) fn grow_seed<G: Adjacency>(
+    ctx: &Ctx<G>,
     kind: SurfaceType,
     seed: &[u32],
     seed_fit: Option<Fit>,
