@@ -53,7 +53,7 @@ use crate::estimate::bezier::{two_pass_curvature, PatchModel};
 use crate::estimate::{orient_normals, pca_normals, PcaParams};
 use crate::geometry::vec3::{dist, dot, normalize};
 use crate::geometry::{Aabb, Csr, Point3};
-use crate::spatial::{knn, Adjacency};
+use crate::spatial::{knn, morton_order, Adjacency};
 use crate::synth::SurfaceType;
 use crate::{Error, Result};
 
@@ -131,6 +131,43 @@ impl PointSegmentation {
 /// Errors: fewer than `max(k, normal_k) + 1` points, a non-finite coordinate, normals of the
 /// wrong length or zero / non-finite, invalid parameters, all points coincident.
 pub fn segment_points(
+    points: &[Point3],
+    normals: Option<&[Point3]>,
+    params: &SegmentParams,
+    pp: &PointParams,
+) -> Result<PointSegmentation> {
+    // The per-point work (curvature regions, growing) walks the neighbour graph; on a cloud in
+    // random order every step is a cache miss. So the cloud is processed in Morton order and
+    // the per-point results are put back into the input order.
+    let finite = points.iter().all(|p| p.iter().all(|v| v.is_finite()));
+    let order = if finite && normals.is_none_or(|n| n.len() == points.len()) {
+        morton_order(points)
+    } else {
+        Vec::new()
+    };
+    if order.len() != points.len() {
+        return segment_ordered(points, normals, params, pp);
+    }
+    let sorted: Vec<Point3> = order.par_iter().map(|&i| points[i as usize]).collect();
+    let sorted_normals: Option<Vec<Point3>> =
+        normals.map(|n| order.par_iter().map(|&i| n[i as usize]).collect());
+    let mut seg = segment_ordered(&sorted, sorted_normals.as_deref(), params, pp)?;
+    fn unsort<T: Copy + Default + Send + Sync>(order: &[u32], v: &[T]) -> Vec<T> {
+        let mut out = vec![T::default(); v.len()];
+        for (r, &i) in order.iter().enumerate() {
+            out[i as usize] = v[r];
+        }
+        out
+    }
+    seg.point_surface = unsort(&order, &seg.point_surface);
+    seg.point_labels = unsort(&order, &seg.point_labels);
+    seg.sharp = unsort(&order, &seg.sharp);
+    seg.point_area = unsort(&order, &seg.point_area);
+    Ok(seg)
+}
+
+/// [`segment_points`] on the points in the given order.
+fn segment_ordered(
     points: &[Point3],
     normals: Option<&[Point3]>,
     params: &SegmentParams,
