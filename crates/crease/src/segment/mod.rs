@@ -347,9 +347,19 @@ pub fn segment_mesh(
         weight: &weight,
         tol,
     };
-    let (owner, regions) = (core.owner, core.regions);
+    let (mut owner, mut regions) = (core.owner, core.regions);
     let t = Instant::now();
-    let face_surface = grow::assign_faces(mesh, topo, &owner, &regions, &tol, params.face_passes);
+    let mut face_surface =
+        grow::assign_faces(mesh, topo, &owner, &regions, &tol, params.face_passes);
+    grow::planar_face_patches(
+        mesh,
+        topo,
+        &tol,
+        crease,
+        &mut face_surface,
+        &mut regions,
+        &mut owner,
+    );
     let surfaces = summarise(topo, &regions, &face_surface, &areas, &ctx);
     let groups = recognize::recognize(
         &surfaces,
