@@ -196,13 +196,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // A boundary vertex is right when its type is that of any of its faces.
     let mut right_any = 0.0;
     let mut total_any = 0.0;
-    for v in 0..nv {
+    for (v, &ty) in types.iter().enumerate() {
         let fs = topo.vertex_faces(v);
         if fs.is_empty() {
             continue;
         }
         total_any += seg.point_area[v];
-        if fs.iter().any(|&f| truth.face_type[f as usize] == types[v]) {
+        if fs.iter().any(|&f| truth.face_type[f as usize] == ty) {
             right_any += seg.point_area[v];
         }
     }

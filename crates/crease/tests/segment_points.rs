@@ -241,13 +241,13 @@ fn abc_vertices_as_a_cloud() {
     .unwrap();
     let types = seg.point_types();
     let (mut right, mut total) = (0.0, 0.0);
-    for v in 0..mesh.num_vertices() {
+    for (v, &ty) in types.iter().enumerate() {
         let fs = topo.vertex_faces(v);
         if fs.is_empty() {
             continue;
         }
         total += seg.point_area[v];
-        if fs.iter().any(|&f| truth.face_type[f as usize] == types[v]) {
+        if fs.iter().any(|&f| truth.face_type[f as usize] == ty) {
             right += seg.point_area[v];
         }
     }
