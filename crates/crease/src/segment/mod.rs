@@ -161,17 +161,21 @@ pub struct Segmentation {
 impl Segmentation {
     /// Per face: the `surface_type` code (255 when unassigned).
     pub fn face_types(&self) -> Vec<u8> {
-        self.face_surface
-            .iter()
-            .map(|&s| {
-                if s < 0 {
-                    SurfaceType::Other.code()
-                } else {
-                    self.surfaces[s as usize].kind.code()
-                }
-            })
-            .collect()
+        type_codes(&self.face_surface, &self.surfaces)
     }
+}
+
+/// The `surface_type` code of every element given its surface id (-1: unassigned, 255).
+pub(crate) fn type_codes(ids: &[i32], surfaces: &[SegmentSurface]) -> Vec<u8> {
+    ids.iter()
+        .map(|&s| {
+            if s < 0 {
+                SurfaceType::Other.code()
+            } else {
+                surfaces[s as usize].kind.code()
+            }
+        })
+        .collect()
 }
 
 fn type_name<S: serde::Serializer>(t: &SurfaceType, s: S) -> std::result::Result<S::Ok, S::Error> {

@@ -54,7 +54,6 @@ use crate::estimate::{orient_normals, pca_normals, PcaParams};
 use crate::geometry::vec3::{dist, dot, normalize};
 use crate::geometry::{Aabb, Csr, Point3};
 use crate::spatial::{knn, morton_order, Adjacency};
-use crate::synth::SurfaceType;
 use crate::{Error, Result};
 
 use super::fit::signed_distance;
@@ -110,16 +109,7 @@ pub struct PointSegmentation {
 impl PointSegmentation {
     /// Per point: the `surface_type` code (255 when unassigned).
     pub fn point_types(&self) -> Vec<u8> {
-        self.point_surface
-            .iter()
-            .map(|&s| {
-                if s < 0 {
-                    SurfaceType::Other.code()
-                } else {
-                    self.surfaces[s as usize].kind.code()
-                }
-            })
-            .collect()
+        super::type_codes(&self.point_surface, &self.surfaces)
     }
 }
 
