@@ -14,6 +14,10 @@
 //! 5. per-face surfaces, surface areas, RMS errors and adjacency;
 //! 6. fillets, linear extrusions and surfaces of revolution (section 6, [`recognize`]).
 //!
+//! Point clouds ([`segment_points`], [`points`]): the same stages 2–4 and 6 over the
+//! symmetrised k-nearest-neighbour graph, with the quadric-fit curvature; stages 2–4 are one
+//! function over any vertex graph ([`crate::spatial::Adjacency`]) for both.
+//!
 //! **Model selection (an addition to the paper).** The labels of section 4 decide a seed's type
 //! in the paper. They are fragile where curvature estimates are: equation 3 tells cones from
 //! cylinders by the variation of `κ_max` over a 2-ring, which is small on both when the mesh is

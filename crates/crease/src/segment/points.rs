@@ -22,20 +22,35 @@
 //! **Curvature (section 3).** The two passes of [`crate::estimate::bezier::two_pass_curvature`]
 //! over the graph, fitting the 6-coefficient quadric of [`crate::estimate::curvature`] (the
 //! point-cloud curvature of the issue) over the region of each point in the tangent plane of
-//! `n_i`; the refitted normal of the quadric is `n'_i`. First pass W = 2 (about 15 points),
-//! points with `|κ_max| l̄ > 0.4` are sharp, second pass W = 5 (about 90 points) never
-//! entering a sharp point: across a crease the quadric would blend the two faces, so, as on
-//! meshes, the second fit of a point near a crease only sees its own side. Sharp points keep
-//! their first-pass values and get no label (section 4), exactly as sharp mesh vertices.
+//! `n_i`; the refitted normal of the quadric is `n'_i` (used by the fits, as on meshes). First
+//! pass W = 2 (about 15 points), points with `|κ_max| l̄ > 0.4` are sharp, second pass W = 5
+//! (about 90 points) never entering a sharp point.
 //!
-//! **Sharp points after growing.** On a mesh the faces at a crease are shared out among the
-//! regions of their vertices. A cloud has no faces, and its sharp points (a band about two
-//! spacings wide along every crease) have PCA normals blended between the two faces, so they
-//! fail equation 5 for both. After growing, each unassigned sharp point therefore joins the
-//! region of a graph neighbour whose surface is nearest to it, if that distance passes
-//! equation 4 (the normal test is skipped for these points only), over up to `face_passes`
-//! rounds (Jacobi-style: each round reads the previous one, so the result does not depend on
-//! the thread count).
+//! **Sharp points: why more than `th_se`.** Across a crease the quadric blends the two faces,
+//! and the first-pass threshold alone does not stop that on clouds: measured on the cube
+//! (20k points, exact normals), only about half of the points within one spacing of an edge
+//! pass `th_se` (the fit's linear terms tilt the plane and halve the apparent bend), and the
+//! graph's edges (up to about two spacings) jump over the thin band that does, so the second
+//! pass of 2900 points 2–5 spacings away still reached across (normals 20–60° off). So, like
+//! the mesh path's dihedral rule (`crease_angle_degrees`), a point is also sharp when the
+//! normal `n` turns towards a graph neighbour faster than the crease angle per mean edge
+//! length: `∠(n_i, n_j) > 30° · |p_i − p_j| / l̄` (unsigned angle). Every graph edge that
+//! crosses a crease has both ends flagged, so no fit region crosses one; a smooth surface is
+//! flagged only where its radius is below about 1.9 `l̄`. These points seed no residual
+//! region either, as on meshes.
+//!
+//! **Left-over points.** On a mesh the faces at a crease are shared out among the regions of
+//! their vertices. A cloud has no faces, and its crease points have PCA normals blended
+//! between the two faces, so they fail equation 5 for both. After growing, each unassigned
+//! point therefore joins the region of a graph neighbour whose surface is nearest to it, if
+//! that distance passes equation 4 (no normal test), over up to `face_passes` rounds
+//! (Jacobi-style: each round reads the previous one, so the result does not depend on the
+//! thread count). Measured on the cube with estimated normals: 1.8 % of the points were left
+//! unassigned without this, 0.01 % with it.
+//!
+//! **Order.** The work walks the graph; on a cloud in random order every step is a cache miss,
+//! so the cloud is processed in Morton order and the per-point results are put back into the
+//! input order (curvature stage at 100k points: 4.4 s → 1.8 s on one thread).
 //!
 //! **Areas.** A point stands for the area `π r_k² / k`, `r_k` being the distance to its k-th
 //! nearest neighbour (the k-nearest-neighbour density estimate); a surface's area is the sum
