@@ -57,11 +57,65 @@ fn box_with_hole_gives_six_planes_and_a_cylinder() {
 }
 
 #[test]
-fn point_cloud_and_bad_thresholds_are_usage_errors() {
+fn point_cloud_gets_per_point_surfaces() {
     let dir = tempfile::tempdir().unwrap();
-    let cloud = synth(dir.path(), &["synth", "cube", "-n", "2000"], "c.ply");
+    let cloud = synth(dir.path(), &["synth", "box-hole", "-n", "20000"], "c.ply");
     let out = dir.path().join("o.ply");
-    run("segment", &cloud, &out, &[]).code(2);
+    let prims = dir.path().join("p.json");
+    let png = dir.path().join("c.png");
+    let a = run(
+        "segment",
+        &cloud,
+        &out,
+        &[
+            "--estimate-normals",
+            "--primitives",
+            prims.to_str().unwrap(),
+            "--render",
+            png.to_str().unwrap(),
+            "--json",
+        ],
+    )
+    .success();
+    let s = json_of(&a.get_output().stdout);
+    assert_eq!(s["by_type"]["plane"], 6);
+    assert_eq!(s["by_type"]["cylinder"], 1);
+    assert_eq!(s["normals"], "estimated");
+    let (geom, _) = crease::io::read(&out, &ReadOptions::default()).unwrap();
+    let (orig, _) = crease::io::read(&cloud, &ReadOptions::default()).unwrap();
+    assert_eq!(
+        geom.points.positions, orig.points.positions,
+        "input point order"
+    );
+    let types = geom.points.attributes.get("surface_type").unwrap();
+    let gt = orig.points.attributes.get("gt_surface_type").unwrap();
+    let right = types
+        .values
+        .iter()
+        .zip(&gt.values)
+        .filter(|(a, b)| a == b)
+        .count();
+    assert!(right as f64 > 0.99 * gt.values.len() as f64, "{right}");
+    assert!(geom.points.attributes.get("surface").is_some());
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&prims).unwrap()).unwrap();
+    let cyl = doc["surfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|x| x["type"] == "cylinder")
+        .unwrap();
+    let r = cyl["params"]["radius"].as_f64().unwrap();
+    assert!((r - 0.2).abs() < 1e-3, "hole radius {r}");
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+}
+
+#[test]
+fn bad_thresholds_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.ply");
+    let cloud = synth(dir.path(), &["synth", "cube", "-n", "2000"], "c.ply");
+    run("segment", &cloud, &out, &["--k", "2"]).code(2);
     let mesh = synth(dir.path(), &["synth", "cube", "--mesh"], "m.ply");
     run("segment", &mesh, &out, &["--th-norm", "95"]).code(2);
     crease()

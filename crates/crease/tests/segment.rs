@@ -286,3 +286,138 @@ fn fillets_extrusions_revolutions_are_recognised() {
     assert_eq!(count(&seg, GroupKind::Fillet), 0);
     assert!(count(&seg, GroupKind::Extrusion) >= 1);
 }
+
+/// The classic meshes of `../shared/data/meshes`: all run, and the analytic ones give the
+/// surfaces they are made of (true values measured on their vertices).
+#[test]
+fn classic_meshes() {
+    let Some(dir) = common::data_dir() else {
+        return;
+    };
+    let seg_of = |name: &str| {
+        let (mesh, _) =
+            crease::io::read_mesh(dir.join("meshes").join(name), &Default::default()).unwrap();
+        let topo = MeshTopology::new(&mesh).unwrap();
+        let seg = segment_mesh(&mesh, &topo, &SegmentParams::default()).unwrap();
+        let assigned = seg.face_surface.iter().filter(|&&s| s >= 0).count();
+        eprintln!(
+            "{name}: {} faces, {assigned} assigned, {:?}",
+            mesh.num_faces(),
+            seg.surfaces
+                .iter()
+                .map(|s| (s.kind.name(), s.faces))
+                .collect::<Vec<_>>()
+        );
+        (mesh, seg, assigned)
+    };
+    let of_kind = |seg: &Segmentation, k: SurfaceType| -> Vec<crease::synth::SurfaceParams> {
+        seg.surfaces
+            .iter()
+            .filter(|s| s.kind == k)
+            .map(|s| s.params)
+            .collect()
+    };
+    use crease::synth::SurfaceParams as P;
+    // cube.obj: 12 triangles, no vertex off a crease: six planes from the face patches.
+    let (_, seg, assigned) = seg_of("cube.obj");
+    assert_eq!(assigned, 12);
+    let planes = of_kind(&seg, SurfaceType::Plane);
+    assert_eq!(planes.len(), 6);
+    for p in planes {
+        let P::Plane { normal, offset } = p else {
+            unreachable!()
+        };
+        assert!(normal.iter().any(|c| (c.abs() - 1.0).abs() < 1e-9));
+        assert!((offset - 0.5).abs() < 1e-9);
+    }
+    // torus.off: one torus; R and r from the vertices' distances to the axis (y through the
+    // centroid): 17.8545 .. 40.0757.
+    let (mesh, seg, assigned) = seg_of("torus.off");
+    assert_eq!(assigned, mesh.num_faces());
+    assert_eq!(seg.surfaces.len(), 1);
+    let n = mesh.num_vertices() as f64;
+    let c: Vec<f64> = (0..3)
+        .map(|i| mesh.positions().iter().map(|p| p[i]).sum::<f64>() / n)
+        .collect();
+    let rho: Vec<f64> = mesh
+        .positions()
+        .iter()
+        .map(|p| (p[0] - c[0]).hypot(p[2] - c[2]))
+        .collect();
+    let (lo, hi) = rho
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &r| (a.min(r), b.max(r)));
+    let P::Torus {
+        axis_dir,
+        major_radius,
+        minor_radius,
+        ..
+    } = seg.surfaces[0].params
+    else {
+        panic!("torus.off: {:?}", seg.surfaces[0].params)
+    };
+    assert!(((major_radius / (0.5 * (hi + lo))) - 1.0).abs() < 0.005);
+    assert!(((minor_radius / (0.5 * (hi - lo))) - 1.0).abs() < 0.005);
+    assert!(axis_dir[1].abs() > 0.9998);
+    // cylinder.off: the unit cylinder along z and its two caps.
+    let (mesh, seg, assigned) = seg_of("cylinder.off");
+    assert_eq!(assigned, mesh.num_faces());
+    let cyl = of_kind(&seg, SurfaceType::Cylinder);
+    assert_eq!(cyl.len(), 1);
+    let P::Cylinder {
+        axis_dir, radius, ..
+    } = cyl[0]
+    else {
+        unreachable!()
+    };
+    assert!((radius - 1.0).abs() < 0.005 && axis_dir[2].abs() > 0.9998);
+    assert_eq!(of_kind(&seg, SurfaceType::Plane).len(), 2);
+    // sharp_sphere.off: a sphere cut by helical grooves (free-form, left unassigned or
+    // approximated); its spherical strips are spheres of the vertices' largest radius.
+    let (mesh, seg, _) = seg_of("sharp_sphere.off");
+    let big = mesh
+        .positions()
+        .iter()
+        .map(|p| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt())
+        .fold(0.0f64, f64::max);
+    let spheres = of_kind(&seg, SurfaceType::Sphere);
+    assert!(spheres.len() >= 3);
+    for s in spheres {
+        let P::Sphere { center, radius } = s else {
+            unreachable!()
+        };
+        assert!((radius / big - 1.0).abs() < 0.005, "{radius} vs {big}");
+        assert!(center.iter().all(|c| c.abs() < 0.01 * big));
+    }
+    // bar.off: the four sides of the square bar (x, y = ±6) and its flat end.
+    let (_, seg, _) = seg_of("bar.off");
+    let sides = of_kind(&seg, SurfaceType::Plane)
+        .into_iter()
+        .filter(|p| matches!(p, P::Plane { normal, offset } if normal[2].abs() < 1e-6 && (offset.abs() - 6.0).abs() < 1e-6))
+        .count();
+    assert_eq!(sides, 4);
+    // cup.off: the inner and outer walls are cylinders of radius 8 and 10 on one axis.
+    let (_, seg, _) = seg_of("cup.off");
+    let radii: Vec<f64> = of_kind(&seg, SurfaceType::Cylinder)
+        .iter()
+        .filter_map(|p| match p {
+            P::Cylinder {
+                radius, axis_dir, ..
+            } if axis_dir[0].abs() > 0.9998 => Some(*radius),
+            _ => None,
+        })
+        .collect();
+    assert!(radii.iter().any(|r| (r - 8.0).abs() < 0.04));
+    assert!(radii.iter().any(|r| (r - 10.0).abs() < 0.05));
+    // The free-form models run and are mostly typed.
+    for name in [
+        "block.off",
+        "fandisk.off",
+        "rocker-arm.off",
+        "screwdriver.off",
+    ] {
+        let (mesh, seg, assigned) = seg_of(name);
+        assert!(!seg.surfaces.is_empty());
+        assert!(assigned > mesh.num_faces() / 4, "{name}: {assigned}");
+    }
+}

@@ -27,9 +27,19 @@
 //! `face_passes` rounds, a compatible region of an edge-adjacent face (faces whose three
 //! vertices are all on creases, common in CAD tessellations). Faces left without one keep the
 //! region holding two or three of their vertices, else -1.
+//!
+//! **Planar face patches (not in the paper).** A coarse CAD tessellation may have planar faces
+//! without a single interior vertex (a cube of 12 triangles: every vertex is on a crease, so
+//! none gets a label and no seed exists). The faces still unassigned are therefore joined
+//! across the edges that are no creases (dihedral angle at most `crease_angle_degrees`), and
+//! every such patch that is enclosed by creases and mesh borders (no smooth edge to an
+//! assigned face: otherwise it is a left-over piece of a curved region) and has at least two
+//! faces, whose vertices all pass equation 4 and whose face normals all pass
+//! equation 5 against the area-weighted plane of its faces becomes a plane.
 
 use crate::geometry::vec3::{dot, scale};
 use crate::geometry::{MeshTopology, Point3, TriMesh};
+use crate::spatial::Adjacency;
 use crate::synth::{SurfaceParams, SurfaceType};
 
 use super::fit::{fit, signed_distance, surface_normal, Fit};
@@ -52,8 +62,8 @@ impl Tol {
 }
 
 /// Data the growing reads.
-pub(crate) struct Ctx<'a> {
-    pub topo: &'a MeshTopology,
+pub(crate) struct Ctx<'a, G: Adjacency> {
+    pub topo: &'a G,
     pub pos: &'a [Point3],
     /// Face-based vertex normals `n_i` (equation 5).
     pub vnormal: &'a [Point3],
@@ -64,7 +74,7 @@ pub(crate) struct Ctx<'a> {
     pub tol: Tol,
 }
 
-impl Ctx<'_> {
+impl<G: Adjacency> Ctx<'_, G> {
     /// Fit of `kind` to vertices `vs`.
     pub fn fit(&self, kind: SurfaceType, vs: &[u32]) -> Option<Fit> {
         let pts: Vec<Point3> = vs.iter().map(|&v| self.pos[v as usize]).collect();
@@ -90,26 +100,32 @@ pub(crate) struct Region {
 
 /// Breadth-first growth of `region` (owned vertices marked with `id` in `owner`) by the
 /// compatible unowned neighbours.
-fn grow_bfs(ctx: &Ctx, s: &SurfaceParams, id: i32, region: &mut Vec<u32>, owner: &mut [i32]) {
+fn grow_bfs<G: Adjacency>(
+    ctx: &Ctx<G>,
+    s: &SurfaceParams,
+    id: i32,
+    region: &mut Vec<u32>,
+    owner: &mut [i32],
+) {
     let mut head = 0;
     while head < region.len() {
         let u = region[head] as usize;
         head += 1;
-        for w in ctx.topo.neighbors(u) {
+        ctx.topo.for_each_neighbor(u, |w| {
             let wi = w as usize;
             if owner[wi] == -1 && ctx.ok(s, w) {
                 owner[wi] = id;
                 region.push(w);
             }
-        }
+        });
     }
 }
 
 /// Grows `seed` (type, vertices, its fit) into a region with id `id`. `None` if the seed fails
 /// its own check: fewer than `min_seed` compatible vertices, or fewer than `min_core_fraction`
 /// of its vertices still free.
-pub(crate) fn grow_seed(
-    ctx: &Ctx,
+pub(crate) fn grow_seed<G: Adjacency>(
+    ctx: &Ctx<G>,
     kind: SurfaceType,
     seed: &[u32],
     seed_fit: Option<Fit>,
@@ -246,4 +262,109 @@ pub(crate) fn assign_faces(
         }
     });
     face
+}
+
+/// Unassigned faces joined across non-crease edges into planar patches that become planes
+/// (see the module documentation). New regions are appended to `regions`; their vertices that
+/// belong to no region yet take the new id in `owner`.
+pub(crate) fn planar_face_patches(
+    mesh: &TriMesh,
+    topo: &MeshTopology,
+    tol: &Tol,
+    crease: f64,
+    face: &mut [i32],
+    regions: &mut Vec<Region>,
+    owner: &mut [i32],
+) {
+    let p = mesh.positions();
+    let fnormals = topo.face_normals();
+    let dihedral = topo.dihedral_angles();
+    let fe = topo.face_edges();
+    let areas = crate::geometry::face_areas(mesh);
+    let mut seen = vec![false; face.len()];
+    for start in 0..face.len() {
+        if seen[start] || face[start] >= 0 {
+            continue;
+        }
+        seen[start] = true;
+        let mut comp = vec![start as u32];
+        let mut head = 0;
+        // Enclosed: every non-crease edge leads to another face of the patch.
+        let mut enclosed = true;
+        while head < comp.len() {
+            let f = comp[head] as usize;
+            head += 1;
+            for &e in &fe[f] {
+                if dihedral[e as usize] > crease {
+                    continue;
+                }
+                for &g in topo.edge_faces(e as usize) {
+                    let gi = g as usize;
+                    if face[gi] >= 0 {
+                        enclosed = false;
+                    } else if !seen[gi] {
+                        seen[gi] = true;
+                        comp.push(g);
+                    }
+                }
+            }
+        }
+        // Area-weighted plane of the patch (normals sign-aligned to the first face).
+        let n0 = fnormals[comp[0] as usize];
+        let (mut nsum, mut csum, mut asum) = ([0.0; 3], [0.0; 3], 0.0);
+        for &f in &comp {
+            let a = areas[f as usize];
+            if !a.is_finite() {
+                continue;
+            }
+            let n = fnormals[f as usize];
+            let sgn = if dot(n, n0) < 0.0 { -a } else { a };
+            nsum = crate::geometry::vec3::add(nsum, scale(n, sgn));
+            let [i, j, k] = mesh.faces[f as usize];
+            let c = crate::geometry::vec3::add(
+                crate::geometry::vec3::add(p[i as usize], p[j as usize]),
+                p[k as usize],
+            );
+            csum = crate::geometry::vec3::add(csum, scale(c, a / 3.0));
+            asum += a;
+        }
+        let Some(normal) = crate::geometry::vec3::normalize(nsum) else {
+            continue;
+        };
+        if asum <= 0.0 {
+            continue;
+        }
+        let offset = dot(normal, scale(csum, 1.0 / asum));
+        let plane = SurfaceParams::Plane { normal, offset };
+        let mut verts: Vec<u32> = comp.iter().flat_map(|&f| mesh.faces[f as usize]).collect();
+        verts.sort_unstable();
+        verts.dedup();
+        let planar = verts
+            .iter()
+            .all(|&v| signed_distance(&plane, p[v as usize]).abs() < tol.pos)
+            && comp
+                .iter()
+                .all(|&f| dot(fnormals[f as usize], normal).abs() > tol.cos_norm);
+        // A single triangle is planar whatever the surface under it.
+        if !planar || !enclosed || comp.len() < 2 {
+            continue;
+        }
+        let id = regions.len() as i32;
+        let pts: Vec<Point3> = verts.iter().map(|&v| p[v as usize]).collect();
+        let w = vec![1.0; pts.len()];
+        let rms = super::fit::rms_distance(&plane, &pts, &w);
+        for &f in &comp {
+            face[f as usize] = id;
+        }
+        for &v in &verts {
+            if owner[v as usize] < 0 {
+                owner[v as usize] = id;
+            }
+        }
+        regions.push(Region {
+            kind: SurfaceType::Plane,
+            fit: Fit { params: plane, rms },
+            vertices: verts,
+        });
+    }
 }

@@ -24,8 +24,8 @@
 
 use rayon::prelude::*;
 
-use crate::geometry::MeshTopology;
 use crate::spatial::mesh_rings::{k_ring_layers, VertexSet};
+use crate::spatial::Adjacency;
 
 /// Vertex labels of equation 2 and Steps 2–3 (the paper's numbers), plus `SHARP` for sharp
 /// vertices and vertices without a curvature estimate.
@@ -114,14 +114,15 @@ pub fn curvature_label(kmax: f64, kmin: f64, eps: f64) -> u8 {
 
 /// Steps 1–3: the label of every vertex.
 ///
-/// Inputs: `kmax`, `kmin` per vertex (1/length), `sharp` flags, `topo`, `eps` (1/length, see
+/// Inputs: `kmax`, `kmin` per vertex (1/length), `sharp` flags, `topo` (mesh edges or a
+/// cloud's neighbour graph), `eps` (1/length, see
 /// [`LabelParams::epsilon`]), `mean_edge`.
 /// Output: one label per vertex (module [`label`]), identical whatever the thread count.
 pub fn vertex_labels(
     kmax: &[f64],
     kmin: &[f64],
     sharp: &[bool],
-    topo: &MeshTopology,
+    topo: &impl Adjacency,
     eps: f64,
     mean_edge: f64,
     p: &LabelParams,
@@ -191,7 +192,7 @@ pub fn vertex_labels(
 /// Step 4: seed regions, the connected sets (along mesh edges) of vertices with the same label
 /// 1..=5 holding at least `th_seed` of that label's vertices. Each seed lists its vertices in
 /// breadth-first order from its smallest vertex id; seeds are ordered by that id.
-pub fn seed_regions(labels: &[u8], topo: &MeshTopology, p: &LabelParams) -> Vec<(u8, Vec<u32>)> {
+pub fn seed_regions(labels: &[u8], topo: &impl Adjacency, p: &LabelParams) -> Vec<(u8, Vec<u32>)> {
     let nv = labels.len();
     let mut seen = vec![false; nv];
     let mut seeds = Vec::new();
@@ -206,13 +207,13 @@ pub fn seed_regions(labels: &[u8], topo: &MeshTopology, p: &LabelParams) -> Vec<
         while head < comp.len() {
             let u = comp[head] as usize;
             head += 1;
-            for w in topo.neighbors(u) {
+            topo.for_each_neighbor(u, |w| {
                 let wi = w as usize;
                 if !seen[wi] && labels[wi] == l {
                     seen[wi] = true;
                     comp.push(w);
                 }
-            }
+            });
         }
         if comp.len() >= p.seed_size(l) {
             seeds.push((l, comp));

@@ -14,6 +14,10 @@
 //! 5. per-face surfaces, surface areas, RMS errors and adjacency;
 //! 6. fillets, linear extrusions and surfaces of revolution (section 6, [`recognize`]).
 //!
+//! Point clouds ([`segment_points`], [`points`]): the same stages 2–4 and 6 over the
+//! symmetrised k-nearest-neighbour graph, with the quadric-fit curvature; stages 2–4 are one
+//! function over any vertex graph ([`crate::spatial::Adjacency`]) for both.
+//!
 //! **Model selection (an addition to the paper).** The labels of section 4 decide a seed's type
 //! in the paper. They are fragile where curvature estimates are: equation 3 tells cones from
 //! cylinders by the variation of `κ_max` over a 2-ring, which is small on both when the mesh is
@@ -31,6 +35,7 @@
 pub mod fit;
 pub mod grow;
 pub mod labels;
+pub mod points;
 pub mod recognize;
 pub mod score;
 
@@ -39,13 +44,15 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::estimate::bezier::{bezier_curvature_with_sharp, BezierParams};
-use crate::geometry::{face_areas, Aabb, MeshTopology, TriMesh};
+use crate::estimate::bezier::{bezier_curvature_with_sharp, BezierCurvature, BezierParams};
+use crate::geometry::{face_areas, Aabb, MeshTopology, Point3, TriMesh};
+use crate::spatial::Adjacency;
 use crate::synth::{SurfaceParams, SurfaceType};
 use crate::{Error, Result};
 
 pub use fit::Fit;
 pub use labels::{label, LabelParams};
+pub use points::{segment_points, PointParams, PointSegmentation};
 
 /// Parameters of [`segment_mesh`]. `Default` = the paper's values (made scale-invariant as
 /// documented on each field).
@@ -158,17 +165,21 @@ pub struct Segmentation {
 impl Segmentation {
     /// Per face: the `surface_type` code (255 when unassigned).
     pub fn face_types(&self) -> Vec<u8> {
-        self.face_surface
-            .iter()
-            .map(|&s| {
-                if s < 0 {
-                    SurfaceType::Other.code()
-                } else {
-                    self.surfaces[s as usize].kind.code()
-                }
-            })
-            .collect()
+        type_codes(&self.face_surface, &self.surfaces)
     }
+}
+
+/// The `surface_type` code of every element given its surface id (-1: unassigned, 255).
+pub(crate) fn type_codes(ids: &[i32], surfaces: &[SegmentSurface]) -> Vec<u8> {
+    ids.iter()
+        .map(|&s| {
+            if s < 0 {
+                SurfaceType::Other.code()
+            } else {
+                surfaces[s as usize].kind.code()
+            }
+        })
+        .collect()
 }
 
 fn type_name<S: serde::Serializer>(t: &SurfaceType, s: S) -> std::result::Result<S::Ok, S::Error> {
@@ -180,8 +191,8 @@ fn type_name<S: serde::Serializer>(t: &SurfaceType, s: S) -> std::result::Result
 /// `simpler_floor · l̄`. Candidates: the seed's label type and the simpler types it can
 /// degenerate to (cylinder / cone seeds: plane, cylinder, cone; sphere: plane, sphere; torus:
 /// all five).
-fn select_model(
-    ctx: &grow::Ctx,
+fn select_model<G: Adjacency>(
+    ctx: &grow::Ctx<G>,
     lab: u8,
     vs: &[u32],
     params: &SegmentParams,
@@ -257,6 +268,21 @@ fn min_points(k: SurfaceType) -> usize {
     }
 }
 
+/// Errors on thresholds outside their ranges.
+pub(crate) fn check_params(params: &SegmentParams) -> Result<()> {
+    if !(params.th_pos > 0.0
+        && params.th_pos.is_finite()
+        && params.th_norm_degrees > 0.0
+        && params.th_norm_degrees < 90.0)
+    {
+        return Err(Error::InvalidArgument(format!(
+            "segmentation: th_pos must be positive and th_norm in (0, 90) degrees, got {} and {}",
+            params.th_pos, params.th_norm_degrees
+        )));
+    }
+    Ok(())
+}
+
 /// Segments `mesh` into analytic surfaces (see the module documentation).
 ///
 /// Inputs: a triangle mesh and its topology (same vertex count).
@@ -268,16 +294,7 @@ pub fn segment_mesh(
     topo: &MeshTopology,
     params: &SegmentParams,
 ) -> Result<Segmentation> {
-    if !(params.th_pos > 0.0
-        && params.th_pos.is_finite()
-        && params.th_norm_degrees > 0.0
-        && params.th_norm_degrees < 90.0)
-    {
-        return Err(Error::InvalidArgument(format!(
-            "segmentation: th_pos must be positive and th_norm in (0, 90) degrees, got {} and {}",
-            params.th_pos, params.th_norm_degrees
-        )));
-    }
+    check_params(params)?;
     let mut timings = Vec::new();
     let t = Instant::now();
     // Vertices on creases of dihedral angle above `crease_angle_degrees` are sharp too.
@@ -293,27 +310,13 @@ pub fn segment_mesh(
         .collect();
     let bez = bezier_curvature_with_sharp(mesh, topo, &params.bezier, Some(&forced))?;
     timings.push(("curvature", t.elapsed().as_secs_f64()));
-    let t = Instant::now();
     let nv = mesh.num_vertices();
     let l = bez.mean_edge;
     let diag = Aabb::from_points(mesh.positions())
         .map(|b| b.diagonal())
         .filter(|d| *d > 0.0)
         .ok_or_else(|| Error::InvalidInput("segmentation: the mesh has no extent".into()))?;
-    let eps = params.labels.epsilon(l, diag);
-    let c = &bez.curvature;
-    let (kmax, kmin): (Vec<f64>, Vec<f64>) =
-        c.k1.iter()
-            .zip(&c.k2)
-            .map(|(&a, &b)| if a.abs() >= b.abs() { (a, b) } else { (b, a) })
-            .unzip();
-    let vertex_labels =
-        labels::vertex_labels(&kmax, &kmin, &bez.sharp, topo, eps, l, &params.labels);
-    let seeds = labels::seed_regions(&vertex_labels, topo, &params.labels);
-    timings.push(("labels", t.elapsed().as_secs_f64()));
-
     // Vertex normals n_i (equation 5) and weights (a third of the incident faces' areas).
-    let t = Instant::now();
     let vnormal = crate::estimate::mesh_vertex_normals(mesh, crate::estimate::Weighting::Area)?;
     let areas = face_areas(mesh);
     let weight: Vec<f64> = (0..nv)
@@ -330,16 +333,125 @@ pub fn segment_mesh(
             a.max(1e-12 * l * l)
         })
         .collect();
+    let core = segment_graph(
+        &GraphInput {
+            graph: topo,
+            pos: mesh.positions(),
+            vnormal: &vnormal,
+            bez: &bez,
+            weight: &weight,
+            no_residual: &forced,
+            diag,
+        },
+        params,
+    );
+    timings.extend(core.timings);
+    let tol = core.tol;
+    let ctx = grow::Ctx {
+        topo,
+        pos: mesh.positions(),
+        vnormal: &vnormal,
+        fnormal: &bez.curvature.normal,
+        weight: &weight,
+        tol,
+    };
+    let (mut owner, mut regions) = (core.owner, core.regions);
+    let t = Instant::now();
+    let mut face_surface =
+        grow::assign_faces(mesh, topo, &owner, &regions, &tol, params.face_passes);
+    grow::planar_face_patches(
+        mesh,
+        topo,
+        &tol,
+        crease,
+        &mut face_surface,
+        &mut regions,
+        &mut owner,
+    );
+    let surfaces = summarise(topo, &regions, &face_surface, &areas, &ctx);
+    let groups = recognize::recognize(
+        &surfaces,
+        params.recognize_angle_degrees.to_radians(),
+        2.0 * params.th_pos * l,
+    );
+    timings.push(("faces", t.elapsed().as_secs_f64()));
+    Ok(Segmentation {
+        groups,
+        surfaces,
+        face_surface,
+        vertex_surface: owner,
+        vertex_labels: core.labels,
+        seeds: core.seeds,
+        mean_edge: l,
+        epsilon: core.epsilon,
+        timings,
+    })
+}
+
+/// Per-vertex inputs of the graph pipeline (labels, seeds, fits, growing) that meshes and
+/// point clouds share.
+pub(crate) struct GraphInput<'a, G: Adjacency> {
+    /// Mesh edges or the cloud's neighbour graph.
+    pub graph: &'a G,
+    pub pos: &'a [Point3],
+    /// Normals `n_i` of equation 5.
+    pub vnormal: &'a [Point3],
+    /// Two-pass curvature: `κ`, refitted normals `n'_i`, sharp flags, `l̄`.
+    pub bez: &'a BezierCurvature,
+    /// Per-vertex area weights.
+    pub weight: &'a [f64],
+    /// Vertices that never seed a residual region (on creases).
+    pub no_residual: &'a [bool],
+    /// Bounding-box diagonal.
+    pub diag: f64,
+}
+
+/// Output of [`segment_graph`].
+pub(crate) struct GraphResult {
+    pub owner: Vec<i32>,
+    pub regions: Vec<grow::Region>,
+    pub labels: Vec<u8>,
+    pub seeds: usize,
+    pub epsilon: f64,
+    pub tol: grow::Tol,
+    pub timings: Vec<(&'static str, f64)>,
+}
+
+/// Sections 4 and 5 over a vertex graph: labels, seeds, fits with model selection, region
+/// growing in descending seed size, then the residual seeds.
+pub(crate) fn segment_graph<G: Adjacency>(
+    input: &GraphInput<G>,
+    params: &SegmentParams,
+) -> GraphResult {
+    let mut timings = Vec::new();
+    let t = Instant::now();
+    let topo = input.graph;
+    let bez = input.bez;
+    let nv = input.pos.len();
+    let l = bez.mean_edge;
+    let eps = params.labels.epsilon(l, input.diag);
+    let c = &bez.curvature;
+    let (kmax, kmin): (Vec<f64>, Vec<f64>) =
+        c.k1.iter()
+            .zip(&c.k2)
+            .map(|(&a, &b)| if a.abs() >= b.abs() { (a, b) } else { (b, a) })
+            .unzip();
+    let vertex_labels =
+        labels::vertex_labels(&kmax, &kmin, &bez.sharp, topo, eps, l, &params.labels);
+    let seeds = labels::seed_regions(&vertex_labels, topo, &params.labels);
+    timings.push(("labels", t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
     let tol = grow::Tol {
         pos: params.th_pos * l,
         cos_norm: params.th_norm_degrees.to_radians().cos(),
     };
     let ctx = grow::Ctx {
         topo,
-        pos: mesh.positions(),
-        vnormal: &vnormal,
+        pos: input.pos,
+        vnormal: input.vnormal,
         fnormal: &c.normal,
-        weight: &weight,
+        weight: input.weight,
         tol,
     };
     // Seed fits, with the model selection.
@@ -378,7 +490,7 @@ pub fn segment_mesh(
         for _round in 0..3 {
             let mut unowned = vec![label::OTHER; nv];
             for v in 0..nv {
-                if owner[v] == -1 && !forced[v] {
+                if owner[v] == -1 && !input.no_residual[v] {
                     unowned[v] = label::TORUS;
                 }
             }
@@ -405,36 +517,24 @@ pub fn segment_mesh(
         }
     }
     timings.push(("growing", t.elapsed().as_secs_f64()));
-
-    let t = Instant::now();
-    let face_surface = grow::assign_faces(mesh, topo, &owner, &regions, &tol, params.face_passes);
-    let surfaces = summarise(topo, &regions, &face_surface, &areas, &ctx);
-    let groups = recognize::recognize(
-        &surfaces,
-        params.recognize_angle_degrees.to_radians(),
-        2.0 * params.th_pos * l,
-    );
-    timings.push(("faces", t.elapsed().as_secs_f64()));
-    Ok(Segmentation {
-        groups,
-        surfaces,
-        face_surface,
-        vertex_surface: owner,
-        vertex_labels,
+    GraphResult {
+        owner,
+        regions,
+        labels: vertex_labels,
         seeds: seeds.len(),
-        mean_edge: l,
         epsilon: eps,
+        tol,
         timings,
-    })
+    }
 }
 
-/// Areas, counts, RMS errors and adjacency of the regions.
+/// Areas, counts, RMS errors and adjacency of the regions of a mesh.
 fn summarise(
     topo: &MeshTopology,
     regions: &[grow::Region],
     face_surface: &[i32],
     areas: &[f64],
-    ctx: &grow::Ctx,
+    ctx: &grow::Ctx<MeshTopology>,
 ) -> Vec<SegmentSurface> {
     let n = regions.len();
     let mut area = vec![0.0; n];
@@ -458,13 +558,26 @@ fn summarise(
             }
         }
     }
+    surfaces_of(regions, &area, &faces, adj, ctx.pos, ctx.weight)
+}
+
+/// The surfaces of the grown regions: per region its area, face count and neighbour list
+/// (any order, repetitions allowed) given; vertex count and RMS error computed.
+pub(crate) fn surfaces_of(
+    regions: &[grow::Region],
+    area: &[f64],
+    faces: &[usize],
+    adj: Vec<Vec<u32>>,
+    pos: &[Point3],
+    weight: &[f64],
+) -> Vec<SegmentSurface> {
     regions
         .par_iter()
+        .zip(adj)
         .enumerate()
-        .map(|(i, r)| {
-            let pts: Vec<_> = r.vertices.iter().map(|&v| ctx.pos[v as usize]).collect();
-            let w: Vec<_> = r.vertices.iter().map(|&v| ctx.weight[v as usize]).collect();
-            let mut nb = adj[i].clone();
+        .map(|(i, (r, mut nb))| {
+            let pts: Vec<_> = r.vertices.iter().map(|&v| pos[v as usize]).collect();
+            let w: Vec<_> = r.vertices.iter().map(|&v| weight[v as usize]).collect();
             nb.sort_unstable();
             nb.dedup();
             SegmentSurface {

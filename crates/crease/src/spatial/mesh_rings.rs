@@ -9,6 +9,7 @@
 
 use rayon::prelude::*;
 
+use super::Adjacency;
 pub use crate::geometry::OneRing;
 use crate::geometry::{Csr, MeshTopology};
 use crate::{Error, Result};
@@ -55,7 +56,7 @@ pub fn vertex_k_rings(topo: &MeshTopology, k: usize) -> Result<Csr> {
 /// The k-ring of one vertex `v` into `out` (cleared first), sorted by ring distance then id,
 /// `v` excluded; `set` is scratch. Panics if `v >= V`.
 pub fn k_ring_layers(
-    topo: &MeshTopology,
+    topo: &impl Adjacency,
     v: u32,
     k: usize,
     set: &mut VertexSet,
@@ -67,7 +68,7 @@ pub fn k_ring_layers(
 /// [`k_ring_layers`], calling `layer_end(len)` after each ring s = 1..=k is complete with the
 /// number of entries of rings 1..=s (called k times, also when the rings run out early).
 pub fn k_ring_layers_with(
-    topo: &MeshTopology,
+    topo: &impl Adjacency,
     v: u32,
     k: usize,
     set: &mut VertexSet,
@@ -80,11 +81,11 @@ pub fn k_ring_layers_with(
     if k == 0 {
         return;
     }
-    for n in topo.neighbors(v as usize) {
+    topo.for_each_neighbor(v as usize, |n| {
         if set.insert(n) {
             out.push(n);
         }
-    }
+    });
     out.sort_unstable();
     layer_end(out.len());
     let mut start = 0usize;
@@ -92,11 +93,11 @@ pub fn k_ring_layers_with(
         let end = out.len();
         for i in start..end {
             let u = out[i];
-            for n in topo.neighbors(u as usize) {
+            topo.for_each_neighbor(u as usize, |n| {
                 if set.insert(n) {
                     out.push(n);
                 }
-            }
+            });
         }
         out[end..].sort_unstable();
         layer_end(out.len());

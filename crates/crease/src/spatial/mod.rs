@@ -1,5 +1,6 @@
 //! Spatial queries: nearest neighbours over point sets, local Delaunay 1-rings, mesh k-rings.
 
+pub mod graph;
 mod grid;
 mod kdtree;
 pub mod knn;
@@ -8,6 +9,7 @@ pub mod morton;
 pub mod radius;
 pub mod ring;
 
+pub use graph::Adjacency;
 pub use kdtree::KdIndex;
 pub use knn::{knn, knn_map, knn_with, KnnMethod, KnnQuery, Neighborhoods};
 pub use morton::morton_order;

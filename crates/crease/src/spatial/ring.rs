@@ -106,56 +106,7 @@ impl Rings {
     /// overlapping 1-ring neighborhood"; since the rings of two points are built from different
     /// neighbourhoods they need not agree, and the union keeps every adjacency either side saw.
     pub fn symmetrized(&self) -> Csr {
-        let n = self.len();
-        let mut counts = vec![0u32; n];
-        for (p, row) in self.rings.rows().enumerate() {
-            counts[p] += row.len() as u32;
-            for &q in row {
-                counts[q as usize] += 1;
-            }
-        }
-        let offsets = Csr::offsets_from_counts(&counts);
-        let mut fill: Vec<u32> = offsets[..n].to_vec();
-        let mut indices = vec![0u32; offsets[n] as usize];
-        for (p, row) in self.rings.rows().enumerate() {
-            for &q in row {
-                indices[fill[p] as usize] = q;
-                fill[p] += 1;
-                indices[fill[q as usize] as usize] = p as u32;
-                fill[q as usize] += 1;
-            }
-        }
-        // Sort and deduplicate every row in parallel, then compact.
-        let mut slices: Vec<&mut [u32]> = Vec::with_capacity(n);
-        let mut rest: &mut [u32] = &mut indices;
-        for &c in &counts {
-            let (head, tail) = rest.split_at_mut(c as usize);
-            slices.push(head);
-            rest = tail;
-        }
-        let lens: Vec<u32> = slices
-            .par_iter_mut()
-            .map(|row| {
-                row.sort_unstable();
-                let mut w = 0;
-                for r in 0..row.len() {
-                    if w == 0 || row[r] != row[w - 1] {
-                        row[w] = row[r];
-                        w += 1;
-                    }
-                }
-                w as u32
-            })
-            .collect();
-        let mut out = Vec::with_capacity(lens.iter().map(|&l| l as usize).sum());
-        for (p, &l) in lens.iter().enumerate() {
-            let start = offsets[p] as usize;
-            out.extend_from_slice(&indices[start..start + l as usize]);
-        }
-        Csr {
-            offsets: Csr::offsets_from_counts(&lens),
-            indices: out,
-        }
+        self.rings.symmetrized()
     }
 }
 
