@@ -237,3 +237,108 @@ fn plane_boundary() {
     .expect("lines");
     assert!(none.edges.is_empty(), "a plane has no sharp edge");
 }
+
+/// `n` points sampled uniformly on the surface of `mesh` (area-weighted triangles, uniform
+/// barycentric coordinates; a fixed seed), with the triangle each point lies on.
+fn sample_surface(mesh: &crease::geometry::TriMesh, n: usize) -> Vec<Point3> {
+    use rand::{Rng, SeedableRng};
+    let areas: Vec<f64> = (0..mesh.num_faces())
+        .map(|f| {
+            let [a, b, c] = mesh.triangle(f);
+            let u = crease::geometry::vec3::sub(b, a);
+            let v = crease::geometry::vec3::sub(c, a);
+            0.5 * crease::geometry::vec3::norm(crease::geometry::vec3::cross(u, v))
+        })
+        .collect();
+    let mut cumulative = Vec::with_capacity(areas.len());
+    let mut total = 0.0;
+    for a in &areas {
+        total += a;
+        cumulative.push(total);
+    }
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+    (0..n)
+        .map(|_| {
+            let t = rng.random::<f64>() * total;
+            let f = cumulative.partition_point(|&c| c < t).min(areas.len() - 1);
+            let [a, b, c] = mesh.triangle(f);
+            let (mut r1, mut r2) = (rng.random::<f64>(), rng.random::<f64>());
+            if r1 + r2 > 1.0 {
+                r1 = 1.0 - r1;
+                r2 = 1.0 - r2;
+            }
+            [0, 1, 2].map(|k| a[k] + r1 * (b[k] - a[k]) + r2 * (c[k] - a[k]))
+        })
+        .collect()
+}
+
+/// Real parts scanned: 60k points sampled uniformly at random on the surfaces of fandisk and
+/// block (`../shared/data/meshes`; random sampling, not a grid, as a scanner gives), against
+/// the mesh edges whose dihedral angle exceeds 30° (the clean-mesh labels of vidal2011 §6.1,
+/// at a crease angle that the designed edges of these parts exceed). Recall: truth edge
+/// midpoints within 2 spacings of a line; precision: line vertices within 2 spacings of a
+/// truth edge. Measured: fandisk 30 polylines, 20 junctions, recall 0.865, precision 0.996;
+/// block exactly its 20 curves (12 box edges, the 4 rims of its two holes and the 4 circles of
+/// its boss) as 8 closed loops and 12 polylines meeting at 8 junctions, recall 0.876,
+/// precision 1.000. No endpoint on either.
+/// (The meshes' own vertices are no fair cloud: block's flat faces have almost no interior
+/// vertex, so its lines cut across them.)
+#[test]
+fn classic_parts_sampled() {
+    let Some(dir) = common::data_dir() else {
+        return;
+    };
+    for (name, min_recall, min_precision) in [("fandisk", 0.83, 0.97), ("block", 0.85, 0.98)] {
+        let path = dir.join("meshes").join(format!("{name}.off"));
+        let (g, _) = crease::io::read(&path, &Default::default()).expect("read");
+        let mesh = g.into_mesh().expect("a mesh");
+        let em = crease::meshfeat::EdgeMesh::new(&mesh).expect("edge mesh");
+        let labels = crease::meshfeat::dihedral_labels(&em, 30.0);
+        let vp = mesh.positions();
+        let truth: Vec<[Point3; 2]> = em
+            .topo
+            .edges()
+            .iter()
+            .zip(&labels)
+            .filter(|(_, &l)| l)
+            .map(|(e, _)| [vp[e[0] as usize], vp[e[1] as usize]])
+            .collect();
+        let pts = sample_surface(&mesh, 60_000);
+        let spacing = crease::geometry::average_spacing(&pts).expect("spacing");
+        let tol = 2.0 * spacing;
+        let net = extract_lines(&pts, &LinesParams::default()).expect("lines");
+        let near_line = |p: Point3| {
+            net.edges.iter().any(|e| {
+                seg_dist(p, net.vertices[e[0] as usize], net.vertices[e[1] as usize]) <= tol
+            })
+        };
+        let recall = truth
+            .iter()
+            .filter(|t| near_line(crease::geometry::vec3::lerp(t[0], t[1], 0.5)))
+            .count() as f64
+            / truth.len() as f64;
+        let precision = net
+            .vertices
+            .iter()
+            .filter(|&&v| truth.iter().any(|t| seg_dist(v, t[0], t[1]) <= tol))
+            .count() as f64
+            / net.vertices.len() as f64;
+        println!(
+            "{name}: {} truth edges; {} polylines, {} closed loops, {} junctions, {} endpoints; \
+             recall {recall:.3}, precision {precision:.3}",
+            truth.len(),
+            net.polylines.len(),
+            net.closed_loops(),
+            net.junctions(),
+            net.endpoints()
+        );
+        assert_eq!(net.endpoints(), 0);
+        if name == "block" {
+            assert_eq!(net.polylines.len(), 20);
+            assert_eq!(net.closed_loops(), 8);
+            assert_eq!(net.junctions(), 8);
+        }
+        assert!(recall >= min_recall, "{name}: recall {recall}");
+        assert!(precision >= min_precision, "{name}: precision {precision}");
+    }
+}
