@@ -34,10 +34,13 @@ pub struct LinesArgs {
     /// Maximum length of the branches pruned by Algorithm 2.
     #[arg(long, default_value_t = 5)]
     pub d_max: usize,
-    /// Candidates of the connect algorithm (default: chosen from the data).
+    /// Do not smooth noisy 1-ring normals before the region growing (the paper as written).
+    #[arg(long)]
+    pub no_denoise: bool,
+    /// Candidates of the connect algorithm (default: 2 d_max, within a reach from the data).
     #[arg(long)]
     pub n: Option<usize>,
-    /// Shortest path allowed between two linked vertices (default: chosen from the data).
+    /// Shortest path allowed between two linked vertices (default: 2 d_max).
     #[arg(long)]
     pub d: Option<usize>,
     /// Leave the cloud's boundary out of the network.
@@ -87,7 +90,7 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
         d: a.d,
         smooth: !a.no_smooth,
         boundary: !a.no_boundary,
-        ..Default::default()
+        denoise_normals: !a.no_denoise,
     };
     let start = Instant::now();
     let stage = Stage::start("sharp lines (Demarsin 2007)", g.quiet);

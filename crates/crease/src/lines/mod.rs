@@ -21,11 +21,15 @@
 //! The network is then split into polylines at junctions (vertices of degree other than 2).
 //!
 //! **Parameters the paper leaves to the user (section 2.7).** n (candidates of the connect
-//! algorithm) and d (shortest acceptable path between linked vertices) are chosen from the
-//! data when not given: n = 2 d_max = 10 nearest graph vertices (small clusters average 1.1 to
-//! 1.6 points, Table 1, so along a line they sit about one spacing apart and n reaches gaps of
-//! a few spacings), and d = 2 d_max = 10 edges, so that linking an endpoint never closes a
-//! cycle shorter than the branches Algorithm 2 already treats as noise.
+//! algorithm) and d (shortest acceptable path between linked vertices) default to 2 d_max = 10
+//! each, and the distance they stand for comes from the data: the candidates of an endpoint are
+//! its n nearest linkable vertices within 2 n h, h being the median edge length of
+//! G_pruned_branches (the spacing of the clusters along the lines; small clusters average 1.1 to
+//! 1.6 points, Table 1, so h is about one point spacing at any density). d = 10 edges means that
+//! linking an endpoint never closes a cycle shorter than the branches Algorithm 2 already treats
+//! as noise; case-2 links must not close a cycle of 2 d. Both can be overridden
+//! (`LinesParams::n`, `LinesParams::d`, `crease lines --n --d`). How the candidates are chosen
+//! and the links ordered differs from the literal reading; see [`graph::close`].
 //!
 //! 7. G_smooth: every vertex moved onto the local intersection of the smooth patches it
 //!    separates ([`smooth`], section 2.8, whose cited report is unavailable).
