@@ -5,7 +5,7 @@
 //!
 //! ```text
 //! cargo run --release -p crease --example train_default [-- --out FILE] [--max-edges N]
-//!     [--per-side 40,70] [--folds K]
+//!     [--per-side 40,70] [--noise 0,0.005] [--folds K]
 //! ```
 //!
 //! Prints the grid, the per-feature F-scores (the paper's Table 1 measure) and the model size.
@@ -32,6 +32,7 @@ fn main() {
             "--max-edges" => sp.max_edges_per_mesh = v.parse().expect("count"),
             "--per-side" => per_side = v.split(',').map(|s| s.parse().expect("number")).collect(),
             "--folds" => tp.folds = v.parse().expect("count"),
+            "--noise" => sp.noise = v.split(',').map(|s| s.parse().expect("number")).collect(),
             a => panic!("unknown option {a}"),
         }
         i += 2;

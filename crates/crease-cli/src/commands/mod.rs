@@ -4,6 +4,7 @@ mod convert;
 pub mod curvature;
 mod demo;
 pub(crate) mod edges;
+pub(crate) mod train;
 pub(crate) mod eval;
 pub(crate) mod fillets;
 mod info;
@@ -42,6 +43,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fillets(a) => fillets::run(g, &a, false),
         Command::Network(a) => fillets::run(g, &a, true),
         Command::Edges(a) => edges::run(g, &a),
+        Command::Train(a) => train::run(g, &a),
         Command::Segment(a) => segment::run(g, &a),
     }
 }
