@@ -13,7 +13,8 @@
 //!
 //! ```text
 //! cargo run --release -p crease --example meshfeat_learned [-- [--samples N] [--only NAME]
-//!     [--max-edges N] [--grid 1] [--model FILE] [--label-degrees D] [--loo 0]]
+//!     [--max-edges N] [--grid 1] [--model FILE] [--label-degrees D] [--loo 0]
+//!     [--synth-per-side 60]]
 //! ```
 
 use std::path::PathBuf;
@@ -39,6 +40,7 @@ struct Opts {
     model: Option<PathBuf>,
     label_degrees: f64,
     loo: bool,
+    synth_per_side: f64,
 }
 
 fn parse() -> Opts {
@@ -50,6 +52,7 @@ fn parse() -> Opts {
         model: None,
         label_degrees: 25.0,
         loo: true,
+        synth_per_side: 60.0,
     };
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut i = 0;
@@ -63,6 +66,7 @@ fn parse() -> Opts {
             "--model" => o.model = Some(PathBuf::from(v)),
             "--label-degrees" => o.label_degrees = v.parse().expect("number"),
             "--loo" => o.loo = v == "1",
+            "--synth-per-side" => o.synth_per_side = v.parse().expect("number"),
             a => panic!("unknown option {a}"),
         }
         i += 2;
@@ -84,7 +88,7 @@ fn cases(o: &Opts) -> Vec<Case> {
         let m = synth_mesh(
             &shape,
             &MeshParams {
-                target_edge: Some(shape.aabb().max_side() / 60.0),
+                target_edge: Some(shape.aabb().max_side() / o.synth_per_side),
                 ..Default::default()
             },
         )
@@ -207,7 +211,12 @@ fn score(o: &Opts, v: &Version, truth: &[bool], model: &SvmModel) -> Scores {
 
 fn main() {
     let o = parse();
-    let all = cases(&o);
+    let mut all = cases(&o);
+    if !o.loo {
+        if let Some(n) = &o.only {
+            all.retain(|c| c.name.contains(n.as_str()));
+        }
+    }
     let fp = match &o.model {
         Some(p) => Arc::new(SvmModel::read(p).expect("model")),
         None => Arc::new(default_model().clone()),

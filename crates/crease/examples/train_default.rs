@@ -5,7 +5,8 @@
 //!
 //! ```text
 //! cargo run --release -p crease --example train_default [-- --out FILE] [--max-edges N]
-//!     [--per-side 40,70] [--noise 0,0.005] [--folds K]
+//!     [--per-side 40,70] [--noise 0,0.005] [--folds K] [--tangent-budget N]
+//!     [--curvature-budget N]
 //! ```
 //!
 //! Prints the grid, the per-feature F-scores (the paper's Table 1 measure) and the model size.
@@ -24,6 +25,7 @@ fn main() {
     let mut sp = SetParams::default();
     let mut per_side = vec![40.0, 70.0];
     let mut tp = TrainParams::default();
+    let mut fp = FeatureParams::default();
     let mut i = 0;
     while i + 1 < args.len() {
         let v = &args[i + 1];
@@ -32,6 +34,8 @@ fn main() {
             "--max-edges" => sp.max_edges_per_mesh = v.parse().expect("count"),
             "--per-side" => per_side = v.split(',').map(|s| s.parse().expect("number")).collect(),
             "--folds" => tp.folds = v.parse().expect("count"),
+            "--tangent-budget" => fp.tangent.max_faces = Some(v.parse().expect("count")),
+            "--curvature-budget" => fp.max_items = Some(v.parse().expect("count")),
             "--noise" => sp.noise = v.split(',').map(|s| s.parse().expect("number")).collect(),
             a => panic!("unknown option {a}"),
         }
@@ -39,7 +43,6 @@ fn main() {
     }
     let t0 = Instant::now();
     let meshes = synthetic_meshes(&per_side).expect("synthetic meshes");
-    let fp = FeatureParams::default();
     let set = training_set(&meshes, &fp, &sp).expect("training set");
     let npos = set.y.iter().filter(|&&t| t).count();
     println!(

@@ -52,18 +52,23 @@ fn features_are_the_43_of_section_4_with_analytic_values() {
             );
         }
     }
-    // Sphere of radius 0.5 in a unit box: both principal curvatures are 1 / 0.5 = 2 in units of
-    // the reference length (1), K = 4, H = 2, K_max − K_min = 0 (normal cycle, Cohen-Steiner
-    // & Morvan). Means over the edges; at the larger scales the balls read a random subset of
-    // the edges, which spreads K_min and K_max apart but leaves H (measured: H 1.98–2.06,
-    // K_min 1.71–2.00, K_max 2.12–2.24).
+    // Sphere of radius 0.5: both principal curvatures are 1 / 0.5 = 2, K = 4, H = 2, K_max −
+    // K_min = 0 (normal cycle, Cohen-Steiner & Morvan); the features hold them times the ball
+    // radius r (K times r²). Means over the edges; at the larger scales the balls read a random
+    // subset of the edges, which spreads K_min and K_max apart but leaves H (measured: H
+    // 1.98–2.06, K_min 1.71–2.00, K_max 2.12–2.24).
     let (mesh, _) = synth("sphere", 40.0);
     let em = EdgeMesh::new(&mesh).unwrap();
-    let f = edge_features(&em, &FeatureParams::default()).unwrap();
-    for s in 0..5 {
+    let p = FeatureParams::default();
+    let f = edge_features(&em, &p).unwrap();
+    for (s, &scale) in p.curvature_scales.iter().enumerate() {
+        let r = (scale * em.reference_length).max(p.min_edge_lengths * em.mean_edge_length);
         let base = CURVATURE_OFFSET + 6 * s;
         let mean = |k: usize| {
-            (0..f.len()).map(|e| f64::from(f.row(e)[base + k])).sum::<f64>() / f.len() as f64
+            let pow = if k == 2 { 2 } else { 1 };
+            (0..f.len()).map(|e| f64::from(f.row(e)[base + k])).sum::<f64>()
+                / f.len() as f64
+                / r.powi(pow)
         };
         let (kmin, kmax, gauss, h, diff) = (mean(0), mean(1), mean(2), mean(3), mean(4));
         let tol = if s < 2 { 0.15 } else { 0.35 };
@@ -73,7 +78,7 @@ fn features_are_the_43_of_section_4_with_analytic_values() {
         assert!((gauss - 4.0).abs() < 2.0 * tol, "scale {s}: K {gauss}");
         assert!(diff < 2.0 * tol, "scale {s}: kmax - kmin {diff}");
         // Constant curvature: no saliency.
-        assert!(mean(5) < 0.05, "scale {s}: saliency {}", mean(5));
+        assert!(mean(5) * r < 0.05, "scale {s}: saliency {}", mean(5) * r);
     }
 }
 
