@@ -156,8 +156,18 @@ fn train_and_learned_edges_on_abc() {
         .args(["train", &spec, "-o"])
         .arg(&model)
         .args([
-            "--noise", "0", "--max-edges", "600", "--c", "2,8", "--gamma", "0.01,0.03", "--folds",
-            "2", "--json", "-q",
+            "--noise",
+            "0",
+            "--max-edges",
+            "600",
+            "--c",
+            "2,8",
+            "--gamma",
+            "0.01,0.03",
+            "--folds",
+            "2",
+            "--json",
+            "-q",
         ])
         .assert()
         .success();

@@ -115,7 +115,7 @@ fn cases(o: &Opts) -> Vec<Case> {
         "sharp_sphere.off",
         "torus.off",
     ] {
-        let (g, _) = crease::io::read(&dir.join("meshes").join(file), &Default::default())
+        let (g, _) = crease::io::read(dir.join("meshes").join(file), &Default::default())
             .expect("mesh file");
         let mesh = g.into_mesh().expect("faces");
         let em = EdgeMesh::new(&mesh).expect("topology");
@@ -130,13 +130,14 @@ fn cases(o: &Opts) -> Vec<Case> {
     }
     let abc = dir.join("abc");
     let (g, _) = crease::io::read(
-        &abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_trimesh_001.obj"),
+        abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_trimesh_001.obj"),
         &Default::default(),
     )
     .expect("ABC obj");
     let mesh = g.into_mesh().expect("faces");
-    let pairs = read_abc_sharp_edges(&abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_features_001.yml"))
-        .expect("ABC yml");
+    let pairs =
+        read_abc_sharp_edges(&abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_features_001.yml"))
+            .expect("ABC yml");
     let em = EdgeMesh::new(&mesh).expect("topology");
     let (truth, _) = labels_from_pairs(&em.topo, &pairs);
     drop(em);
@@ -196,7 +197,9 @@ fn score(o: &Opts, v: &Version, truth: &[bool], model: &SvmModel) -> Scores {
                 potts_labels_unary(&em, &pairs, &em.dihedral, &svm_unary(&d, b), &p).expect("cut")
             })
             .collect();
-        sweep_auc(&labellings, truth).map(|r| r.0).unwrap_or(f64::NAN)
+        sweep_auc(&labellings, truth)
+            .map(|r| r.0)
+            .unwrap_or(f64::NAN)
     } else {
         f64::NAN
     };
@@ -255,7 +258,11 @@ fn main() {
     eprintln!("features: {:.1} s", t0.elapsed().as_secs_f64());
     let t1 = Instant::now();
     let selected: Vec<usize> = (0..all.len())
-        .filter(|&i| o.only.as_ref().is_none_or(|n| all[i].name.contains(n.as_str())))
+        .filter(|&i| {
+            o.only
+                .as_ref()
+                .is_none_or(|n| all[i].name.contains(n.as_str()))
+        })
         .collect();
     // Leave-one-out models.
     let loo: Vec<SvmModel> = selected
@@ -268,8 +275,14 @@ fn main() {
                     continue;
                 }
                 for (j, v) in versions[i].iter().enumerate() {
-                    set.add_mesh(&c.name, &v.features, &c.truth, o.max_edges, (i * 2 + j) as u64)
-                        .expect("training set");
+                    set.add_mesh(
+                        &c.name,
+                        &v.features,
+                        &c.truth,
+                        o.max_edges,
+                        (i * 2 + j) as u64,
+                    )
+                    .expect("training set");
                 }
             }
             let tp = TrainParams {
@@ -299,7 +312,10 @@ fn main() {
             m
         })
         .collect();
-    eprintln!("leave-one-out training: {:.1} s", t1.elapsed().as_secs_f64());
+    eprintln!(
+        "leave-one-out training: {:.1} s",
+        t1.elapsed().as_secs_f64()
+    );
     let t2 = Instant::now();
     for (k, noisy) in [false, true].into_iter().enumerate() {
         println!(
@@ -309,8 +325,17 @@ fn main() {
         );
         println!(
             "{:<22}{:>7}{:>6}{:>8}{:>8}{:>9}{:>8}{:>9}{:>8}{:>10}{:>14}",
-            "mesh", "#edges", "#f.e.", "thres.", "tangent", "learn-D", "LOO", "p-lrn-D", "LOO",
-            "TPR@1e-4", "TPR/FPR d>0"
+            "mesh",
+            "#edges",
+            "#f.e.",
+            "thres.",
+            "tangent",
+            "learn-D",
+            "LOO",
+            "p-lrn-D",
+            "LOO",
+            "TPR@1e-4",
+            "TPR/FPR d>0"
         );
         let mut sums = [0.0; 6];
         let mut sums_classic = [0.0; 6];
@@ -335,7 +360,11 @@ fn main() {
             ];
             print!("{:<22}{:>7}{:>6}", c.name, c.truth.len(), pos);
             for (j, a) in row.iter().enumerate() {
-                print!("{:>w$.2}", 100.0 * a, w = if j == 2 || j == 4 { 9 } else { 8 });
+                print!(
+                    "{:>w$.2}",
+                    100.0 * a,
+                    w = if j == 2 || j == 4 { 9 } else { 8 }
+                );
             }
             println!(
                 "{:>10.1}{:>8.1}/{:<5.0}",
@@ -362,7 +391,11 @@ fn main() {
         ] {
             print!("{label:<35}");
             for (j, a) in s.iter().enumerate() {
-                print!("{:>w$.2}", 100.0 * a / m.max(1) as f64, w = if j == 2 || j == 4 { 9 } else { 8 });
+                print!(
+                    "{:>w$.2}",
+                    100.0 * a / m.max(1) as f64,
+                    w = if j == 2 || j == 4 { 9 } else { 8 }
+                );
             }
             println!();
         }

@@ -43,7 +43,11 @@ fn features_are_the_43_of_section_4_with_analytic_values() {
     for (e, &t) in truth.iter().enumerate() {
         let want = if t { 0.0 } else { 1.0 };
         let r = f.row(e);
-        assert!((r[0] - want).abs() < 1e-5, "edge {e}: cos dihedral {}", r[0]);
+        assert!(
+            (r[0] - want).abs() < 1e-5,
+            "edge {e}: cos dihedral {}",
+            r[0]
+        );
         for s in 0..9 {
             assert!(
                 (r[TANGENT_OFFSET + s] - want).abs() < 1e-4,
@@ -66,7 +70,9 @@ fn features_are_the_43_of_section_4_with_analytic_values() {
         let base = CURVATURE_OFFSET + 6 * s;
         let mean = |k: usize| {
             let pow = if k == 2 { 2 } else { 1 };
-            (0..f.len()).map(|e| f64::from(f.row(e)[base + k])).sum::<f64>()
+            (0..f.len())
+                .map(|e| f64::from(f.row(e)[base + k]))
+                .sum::<f64>()
                 / f.len() as f64
                 / r.powi(pow)
         };
@@ -177,7 +183,7 @@ fn learned_beats_the_tangent_angle_on_noisy_fandisk() {
     let Some(dir) = common::data_dir() else {
         return;
     };
-    let (g, _) = crease::io::read(&dir.join("meshes/fandisk.off"), &Default::default()).unwrap();
+    let (g, _) = crease::io::read(dir.join("meshes/fandisk.off"), &Default::default()).unwrap();
     let mesh = g.into_mesh().unwrap();
     let truth = dihedral_labels(&EdgeMesh::new(&mesh).unwrap(), 25.0);
     let noisy = add_noise(&mesh, 0.005, 7).unwrap();

@@ -4,7 +4,6 @@ mod convert;
 pub mod curvature;
 mod demo;
 pub(crate) mod edges;
-pub(crate) mod train;
 pub(crate) mod eval;
 pub(crate) mod fillets;
 mod info;
@@ -14,6 +13,7 @@ mod render;
 pub(crate) mod segment;
 pub(crate) mod sharp;
 mod synth;
+pub(crate) mod train;
 
 use std::path::Path;
 

@@ -94,7 +94,10 @@ fn labelled(g: &Global, spec: &str, label_degrees: f64) -> anyhow::Result<Labell
                 })?
             };
             let n = mesh.vertices.len();
-            if let Some(e) = pairs.iter().find(|e| e[0] as usize >= n || e[1] as usize >= n) {
+            if let Some(e) = pairs
+                .iter()
+                .find(|e| e[0] as usize >= n || e[1] as usize >= n)
+            {
                 anyhow::bail!(
                     "{}: true edge ({}, {}) refers to a vertex beyond the {n} of {}",
                     t.display(),
@@ -114,7 +117,10 @@ fn labelled(g: &Global, spec: &str, label_degrees: f64) -> anyhow::Result<Labell
             (truth, t.display().to_string())
         }
         None => match own_pairs {
-            Some(pairs) => (labels_from_pairs(&em.topo, &pairs).0, "edge property".into()),
+            Some(pairs) => (
+                labels_from_pairs(&em.topo, &pairs).0,
+                "edge property".into(),
+            ),
             None => (
                 dihedral_labels(&em, label_degrees),
                 format!("dihedral > {label_degrees} deg"),
@@ -170,7 +176,11 @@ pub fn run(g: &Global, a: &TrainArgs) -> anyhow::Result<()> {
     if a.max_edges < 2 {
         return Err(usage("--max-edges must be at least 2"));
     }
-    if let Some(v) = a.c.iter().chain(&a.gamma).find(|v| !(v.is_finite() && **v > 0.0)) {
+    if let Some(v) =
+        a.c.iter()
+            .chain(&a.gamma)
+            .find(|v| !(v.is_finite() && **v > 0.0))
+    {
         return Err(usage(format!("--c and --gamma must be positive, got {v}")));
     }
     let inputs: Vec<PathBuf> = a
@@ -203,7 +213,11 @@ pub fn run(g: &Global, a: &TrainArgs) -> anyhow::Result<()> {
     stage.finish();
     let d = TrainParams::default();
     let tp = TrainParams {
-        c_grid: if a.c.is_empty() { d.c_grid } else { a.c.clone() },
+        c_grid: if a.c.is_empty() {
+            d.c_grid
+        } else {
+            a.c.clone()
+        },
         gamma_grid: if a.gamma.is_empty() {
             d.gamma_grid
         } else {
@@ -213,7 +227,11 @@ pub fn run(g: &Global, a: &TrainArgs) -> anyhow::Result<()> {
         description: format!(
             "crease train: {} meshes{}, noise {:?}, <= {} edges per mesh version",
             a.meshes.len(),
-            if a.synthetic { " + synthetic parts" } else { "" },
+            if a.synthetic {
+                " + synthetic parts"
+            } else {
+                ""
+            },
             sp.noise,
             a.max_edges
         ),

@@ -136,7 +136,14 @@ pub fn feature_names(tangent_scales: &[f64], curvature_scales: &[f64]) -> Vec<St
         n.push(format!("cos_tangent_{:.0}", s * 100.0));
     }
     for s in curvature_scales {
-        for k in ["kmin", "kmax", "gauss", "mean", "kmax_minus_kmin", "saliency"] {
+        for k in [
+            "kmin",
+            "kmax",
+            "gauss",
+            "mean",
+            "kmax_minus_kmin",
+            "saliency",
+        ] {
             n.push(format!("{k}_{:.0}", s * 100.0));
         }
     }
@@ -334,7 +341,10 @@ fn vertex_curvatures(em: &EdgeMesh, radii: &[f64], params: &FeatureParams) -> Ve
                 return 0.0;
             }
             // Convex: face b's barycentre lies below face a's plane.
-            let concave = vec3::dot(em.normals[fa], vec3::sub(em.centroids[fb], em.centroids[fa]));
+            let concave = vec3::dot(
+                em.normals[fa],
+                vec3::sub(em.centroids[fb], em.centroids[fa]),
+            );
             let s = if concave > 0.0 { -1.0 } else { 1.0 };
             sign * s * em.dihedral[e]
         })
@@ -518,7 +528,10 @@ pub fn edge_features(em: &EdgeMesh, params: &FeatureParams) -> Result<EdgeFeatur
     let ne = topo.num_edges();
     let t0 = std::time::Instant::now();
     let tangent = tangent_angles(em, &params.tangent)?;
-    tracing::info!("features: tangent-plane angles {:.2} s", t0.elapsed().as_secs_f64());
+    tracing::info!(
+        "features: tangent-plane angles {:.2} s",
+        t0.elapsed().as_secs_f64()
+    );
     let nt = tangent.num_scales();
     let nc = params.curvature_scales.len();
     let dim = 4 + nt + 6 * nc;
@@ -578,36 +591,33 @@ pub fn edge_features(em: &EdgeMesh, params: &FeatureParams) -> Result<EdgeFeatur
     tracing::info!("features: saliency {:.2} s", t0.elapsed().as_secs_f64());
 
     let mut values = vec![0f32; ne * dim];
-    values
-        .par_chunks_mut(dim)
-        .enumerate()
-        .for_each(|(e, row)| {
-            let [a, b] = topo.edges()[e];
-            let (a, b) = (a as usize, b as usize);
-            row[0] = em.dihedral[e].cos() as f32;
-            let opp: Vec<u32> = if topo.edge_faces(e).len() == 2 {
-                topo.edge_opposite_vertices(e).collect()
-            } else {
-                Vec::new()
-            };
-            row[1] = if opp.len() == 2 {
-                vec3::dot(vnormal[opp[0] as usize], vnormal[opp[1] as usize]) as f32
-            } else {
-                -1.0
-            };
-            row[2] = (0.5 * (min_cos[a] + min_cos[b])) as f32;
-            row[3] = (0.5 * (variation[a] + variation[b])) as f32;
-            for (s, ang) in tangent.edge(e).iter().enumerate() {
-                row[4 + s] = ang.cos() as f32;
+    values.par_chunks_mut(dim).enumerate().for_each(|(e, row)| {
+        let [a, b] = topo.edges()[e];
+        let (a, b) = (a as usize, b as usize);
+        row[0] = em.dihedral[e].cos() as f32;
+        let opp: Vec<u32> = if topo.edge_faces(e).len() == 2 {
+            topo.edge_opposite_vertices(e).collect()
+        } else {
+            Vec::new()
+        };
+        row[1] = if opp.len() == 2 {
+            vec3::dot(vnormal[opp[0] as usize], vnormal[opp[1] as usize]) as f32
+        } else {
+            -1.0
+        };
+        row[2] = (0.5 * (min_cos[a] + min_cos[b])) as f32;
+        row[3] = (0.5 * (variation[a] + variation[b])) as f32;
+        for (s, ang) in tangent.edge(e).iter().enumerate() {
+            row[4 + s] = ang.cos() as f32;
+        }
+        for s in 0..nc {
+            let base = 4 + nt + 6 * s;
+            let (ca, cb) = (curv[a * nc + s], curv[b * nc + s]);
+            for k in 0..5 {
+                row[base + k] = (0.5 * (ca[k] + cb[k])) as f32;
             }
-            for s in 0..nc {
-                let base = 4 + nt + 6 * s;
-                let (ca, cb) = (curv[a * nc + s], curv[b * nc + s]);
-                for k in 0..5 {
-                    row[base + k] = (0.5 * (ca[k] + cb[k])) as f32;
-                }
-                row[base + 5] = (0.5 * (sal[a * nc + s] + sal[b * nc + s])) as f32;
-            }
-        });
+            row[base + 5] = (0.5 * (sal[a * nc + s] + sal[b * nc + s])) as f32;
+        }
+    });
     Ok(EdgeFeatures { dim, values })
 }

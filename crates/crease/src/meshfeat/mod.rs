@@ -40,8 +40,8 @@ pub use baseline::{hysteresis_scores, threshold};
 pub use features::{edge_features, EdgeFeatures, FeatureParams, NUM_FEATURES};
 pub use potts::{potts_labels, potts_labels_unary, svm_unary, EdgePairs, PottsParams};
 pub use svm::{default_model, SvmModel, TrainParams, TrainingSet};
-pub use train::{synthetic_meshes, training_set, LabelledMesh, SetParams};
 pub use tangent::{tangent_angles, TangentAngles, TangentParams, PAPER_SCALES};
+pub use train::{synthetic_meshes, training_set, LabelledMesh, SetParams};
 pub use truth::{add_noise, dihedral_labels, labels_from_pairs, read_abc_sharp_edges};
 
 use crate::eval::roc::{trapezoid_area, RocPoint};

@@ -245,30 +245,28 @@ impl SvmModel {
         }
         let gamma = self.gamma as f32;
         let mut out = vec![0f64; f.len()];
-        out.par_chunks_mut(64)
-            .enumerate()
-            .for_each(|(ci, chunk)| {
-                let mut x = vec![0f32; pd];
-                for (j, o) in chunk.iter_mut().enumerate() {
-                    let e = ci * 64 + j;
-                    self.normalizer.apply(f.row(e), &mut x[..d]);
-                    let x2: f32 = x.iter().map(|v| v * v).sum();
-                    let mut acc = 0f64;
-                    for i in 0..nsv {
-                        let s = &sv[i * pd..(i + 1) * pd];
-                        let mut lanes = [0f32; LANES];
-                        for (xs, ss) in x.chunks_exact(LANES).zip(s.chunks_exact(LANES)) {
-                            for l in 0..LANES {
-                                lanes[l] += xs[l] * ss[l];
-                            }
+        out.par_chunks_mut(64).enumerate().for_each(|(ci, chunk)| {
+            let mut x = vec![0f32; pd];
+            for (j, o) in chunk.iter_mut().enumerate() {
+                let e = ci * 64 + j;
+                self.normalizer.apply(f.row(e), &mut x[..d]);
+                let x2: f32 = x.iter().map(|v| v * v).sum();
+                let mut acc = 0f64;
+                for i in 0..nsv {
+                    let s = &sv[i * pd..(i + 1) * pd];
+                    let mut lanes = [0f32; LANES];
+                    for (xs, ss) in x.chunks_exact(LANES).zip(s.chunks_exact(LANES)) {
+                        for l in 0..LANES {
+                            lanes[l] += xs[l] * ss[l];
                         }
-                        let dot: f32 = lanes.iter().sum();
-                        let d2 = (x2 + sv2[i] - 2.0 * dot).max(0.0);
-                        acc += f64::from(self.coef[i] * (-gamma * d2).exp());
                     }
-                    *o = acc + self.bias;
+                    let dot: f32 = lanes.iter().sum();
+                    let d2 = (x2 + sv2[i] - 2.0 * dot).max(0.0);
+                    acc += f64::from(self.coef[i] * (-gamma * d2).exp());
                 }
-            });
+                *o = acc + self.bias;
+            }
+        });
         Ok(out)
     }
 }
@@ -336,10 +334,10 @@ impl TrainingSet {
         let mut seen = std::collections::HashSet::new();
         let mut pos = Vec::new();
         let mut neg = Vec::new();
-        for e in 0..f.len() {
+        for (e, &t) in truth.iter().enumerate() {
             let key: Vec<u32> = f.row(e).iter().map(|v| v.to_bits()).collect();
-            if seen.insert((key, truth[e])) {
-                if truth[e] {
+            if seen.insert((key, t)) {
+                if t {
                     pos.push(e);
                 } else {
                     neg.push(e);
