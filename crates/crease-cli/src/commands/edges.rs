@@ -23,7 +23,7 @@ pub struct EdgesArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// The method (default: the most accurate measured on noisy meshes).
-    #[arg(long, value_enum, default_value_t = MethodArg::Tangent)]
+    #[arg(long, value_enum, default_value_t = MethodArg::Learned)]
     pub method: MethodArg,
     /// Threshold angle, degrees: of `dihedral` and `tangent`, the high threshold of
     /// `hysteresis` (the low one is half), θ_true of the `potts-*` data term.
