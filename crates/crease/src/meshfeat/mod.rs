@@ -17,9 +17,11 @@
 //! [`feature_polylines`] chains the feature edges into polylines.
 //!
 //! * [`features`]: the 43-dimensional feature vector of section 4;
-//! * [`svm`]: the RBF SVM trained on it (section 6.3), its model file and the default model;
-//!   `learned` thresholds its decision value, `potts-learned` feeds it to equation 1 as the
-//!   data term of equation 2.
+//! * [`svm`]: the RBF SVM trained on it (section 6.3), its model file and the default model
+//!   (trained on synthetic parts only, `examples/train_default.rs`); `learned` (the default
+//!   method) thresholds its decision value at 0, `potts-learned` feeds it to equation 1 as the
+//!   data term of equation 2;
+//! * [`train`]: labelled meshes, the synthetic training parts and the training set.
 
 pub mod baseline;
 pub mod features;

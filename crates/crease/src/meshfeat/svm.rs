@@ -5,11 +5,11 @@
 //! equation 2.
 //!
 //! **Why crease has its own solver.** linfa-svm (the Rust SVM crate) has the RBF kernel and
-//! per-class weights (`pos_neg_weights`), but its fitted model keeps the support vectors in a
-//! private field (only `alpha`, `rho` and `weighted_sum` are public) and it pulls ndarray,
-//! sprs and linfa-kernel in for a few hundred lines of solver; crease needs the support
-//! vectors themselves, to save a compact versioned model and to evaluate the decision
-//! function over millions of edges in parallel with its own vectorised kernel loop. The
+//! per-class weights (`pos_neg_weights`), but its fitted `Svm` (docs.rs, 0.7) exposes only
+//! `alpha`, `rho`, `nsupport` and `weighted_sum`: the support vectors stay in a private field,
+//! and it brings the ndarray / linfa stack in for a few hundred lines of solver. crease needs
+//! the support vectors themselves, to save a compact versioned model and to evaluate the
+//! decision function over millions of edges in parallel with its own vectorised kernel loop. The
 //! solver here is the SMO of LIBSVM (the library the paper used): C-SVC dual with per-class
 //! bounds C₊ = 9 C, C₋ = C, working-set selection by second-order information (Fan, Chen &
 //! Lin, JMLR 2005), the full kernel matrix in memory (training sets are capped at a few
