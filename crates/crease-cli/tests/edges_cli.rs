@@ -210,9 +210,14 @@ fn learned_usage_errors() {
     let bad = dir.path().join("bad.json");
     std::fs::write(&bad, "{\"format\": \"something else\"}").unwrap();
     // --model with a method that does not use it: usage error.
-    run("edges", &mesh, &out, &["--model", bad.to_str().unwrap()])
-        .failure()
-        .code(2);
+    run(
+        "edges",
+        &mesh,
+        &out,
+        &["--method", "tangent", "--model", bad.to_str().unwrap()],
+    )
+    .failure()
+    .code(2);
     // A bad model file: an error naming it.
     let a = run(
         "edges",
