@@ -73,6 +73,8 @@ pub enum Command {
     /// Feature edges of a triangle mesh that survive noise (tangent-plane angle, Potts energy
     /// minimised by a graph cut; dihedral and hysteresis thresholding as baselines).
     Edges(crate::commands::edges::EdgesArgs),
+    /// Train the learned edge classifier (RBF SVM) on meshes with ground truth.
+    Train(crate::commands::train::TrainArgs),
     /// Segment a triangle mesh into planes, cylinders, cones, spheres and tori with their
     /// parameters (Mizoguchi et al.).
     Segment(crate::commands::segment::SegmentArgs),

@@ -114,7 +114,14 @@ fn noisy_part_tangent_angle_beats_dihedral_thresholding() {
         },
     )
     .unwrap();
-    let tn = detect_prepared(&em, &EdgeParams::default()).unwrap();
+    let tn = detect_prepared(
+        &em,
+        &EdgeParams {
+            method: EdgeMethod::Tangent,
+            ..EdgeParams::default()
+        },
+    )
+    .unwrap();
     let pt = detect_prepared(
         &em,
         &EdgeParams {

@@ -23,7 +23,7 @@ pub struct EdgesArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// The method (default: the most accurate measured on noisy meshes).
-    #[arg(long, value_enum, default_value_t = MethodArg::Tangent)]
+    #[arg(long, value_enum, default_value_t = MethodArg::Learned)]
     pub method: MethodArg,
     /// Threshold angle, degrees: of `dihedral` and `tangent`, the high threshold of
     /// `hysteresis` (the low one is half), θ_true of the `potts-*` data term.
@@ -36,6 +36,14 @@ pub struct EdgesArgs {
     /// Weight μ of the Potts pairwise term.
     #[arg(long)]
     pub mu: Option<f64>,
+    /// SVM model of `learned` / `potts-learned` (written by `crease train`; default: the
+    /// model shipped with crease, trained on synthetic parts).
+    #[arg(long, value_name = "FILE")]
+    pub model: Option<PathBuf>,
+    /// Added to the SVM decision value before thresholding at 0 (`learned`) or entering the
+    /// data term (`potts-learned`): > 0 finds more edges.
+    #[arg(long, allow_hyphen_values = true)]
+    pub bias: Option<f64>,
     /// Also write the feature edges chained into polylines (.obj `l` lines or .ply edges).
     #[arg(long, value_name = "FILE")]
     pub lines: Option<PathBuf>,
@@ -57,6 +65,10 @@ pub enum MethodArg {
     PottsDihedral,
     /// Potts energy with the tangent-plane angle as data term.
     PottsTangent,
+    /// RBF SVM on the 43 features of section 4 (decision value above 0).
+    Learned,
+    /// Potts energy with the SVM data term (equation 2), minimised exactly by a graph cut.
+    PottsLearned,
 }
 
 impl From<MethodArg> for EdgeMethod {
@@ -67,6 +79,8 @@ impl From<MethodArg> for EdgeMethod {
             MethodArg::Tangent => EdgeMethod::Tangent,
             MethodArg::PottsDihedral => EdgeMethod::PottsDihedral,
             MethodArg::PottsTangent => EdgeMethod::PottsTangent,
+            MethodArg::Learned => EdgeMethod::Learned,
+            MethodArg::PottsLearned => EdgeMethod::PottsLearned,
         }
     }
 }
@@ -102,6 +116,21 @@ pub fn run(g: &Global, a: &EdgesArgs) -> anyhow::Result<()> {
             return Err(usage(format!("--mu must be finite and >= 0, got {mu}")));
         }
         params.potts.mu = mu;
+    }
+    if let Some(b) = a.bias {
+        if !b.is_finite() {
+            return Err(usage(format!("--bias must be finite, got {b}")));
+        }
+        params.decision_bias = b;
+    }
+    if let Some(path) = &a.model {
+        if !params.method.uses_model() {
+            return Err(usage(format!(
+                "--model is used by the learned methods, not by --method {}",
+                params.method.name()
+            )));
+        }
+        params.model = Some(std::sync::Arc::new(crease::meshfeat::SvmModel::read(path)?));
     }
     let (geom, report) = super::load(g, &a.input)?;
     let Some(mesh) = geom.into_mesh() else {
@@ -162,6 +191,8 @@ pub fn run(g: &Global, a: &EdgesArgs) -> anyhow::Result<()> {
             "threshold_degrees": params.threshold_degrees,
             "tangent_scales": params.tangent.scales,
             "potts": params.potts,
+            "model": a.model,
+            "decision_bias": params.decision_bias,
             "timings": det.timings,
             "seconds": seconds,
         });

@@ -13,6 +13,7 @@ mod render;
 pub(crate) mod segment;
 pub(crate) mod sharp;
 mod synth;
+pub(crate) mod train;
 
 use std::path::Path;
 
@@ -42,6 +43,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fillets(a) => fillets::run(g, &a, false),
         Command::Network(a) => fillets::run(g, &a, true),
         Command::Edges(a) => edges::run(g, &a),
+        Command::Train(a) => train::run(g, &a),
         Command::Segment(a) => segment::run(g, &a),
     }
 }

@@ -270,7 +270,7 @@ impl FaceGrid {
 
 /// The level of a face: leading zero bits of a SplitMix64 hash of its id (level ≥ l holds a
 /// fraction 2⁻ˡ of the faces, independently of the mesh's face order statistics).
-fn face_level(f: u32) -> u32 {
+pub(crate) fn subset_level(f: u32) -> u32 {
     let mut z = u64::from(f).wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
@@ -332,7 +332,7 @@ pub fn tangent_angles(em: &EdgeMesh, params: &TangentParams) -> Result<TangentAn
     // Level per scale from the expected number of faces in a disc of radius r.
     let total_area: f64 = em.areas.iter().sum();
     let mean_area = if nf > 0 { total_area / nf as f64 } else { 0.0 };
-    let face_levels: Vec<u32> = (0..nf as u32).into_par_iter().map(face_level).collect();
+    let face_levels: Vec<u32> = (0..nf as u32).into_par_iter().map(subset_level).collect();
     let max_level = 40u32;
     let levels: Vec<u32> = radii
         .iter()
