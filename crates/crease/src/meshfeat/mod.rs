@@ -25,6 +25,7 @@
 
 pub mod baseline;
 pub mod features;
+mod grid;
 pub mod potts;
 pub mod svm;
 pub mod tangent;

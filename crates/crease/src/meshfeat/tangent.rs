@@ -63,6 +63,7 @@
 
 use rayon::prelude::*;
 
+use super::grid::BallGrid;
 use super::EdgeMesh;
 use crate::geometry::{vec3, Point3};
 use crate::{Error, Result};
@@ -142,25 +143,16 @@ impl TangentAngles {
     }
 }
 
-/// One face in a [`FaceGrid`]: what the growing reads, stored contiguously in cell order so
-/// that a sphere query touches consecutive memory (on a 1M-edge mesh, reading the faces
-/// through their ids instead cost three times as much, in cache misses).
+/// One face in a face grid: what the growing reads (its barycentre is the grid point).
 #[derive(Clone, Copy)]
 struct Item {
-    c: Point3,
     n: Point3,
     area: f64,
     face: u32,
 }
 
 /// A uniform grid over the barycentres of one subset of the faces.
-struct FaceGrid {
-    origin: Point3,
-    inv_cell: f64,
-    dims: [usize; 3],
-    offsets: Vec<u32>,
-    items: Vec<Item>,
-}
+type FaceGrid = BallGrid<Item>;
 
 /// A face in the sphere of an edge: signed distance to the separating plane, squared distance
 /// to the midpoint, normal, area.
@@ -172,100 +164,23 @@ struct Cand {
     area: f64,
 }
 
-impl FaceGrid {
-    fn new(em: &EdgeMesh, faces: Vec<u32>, cell: f64) -> FaceGrid {
-        let centroids = &em.centroids;
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for &f in &faces {
-            let c = centroids[f as usize];
-            for k in 0..3 {
-                lo[k] = lo[k].min(c[k]);
-                hi[k] = hi[k].max(c[k]);
-            }
-        }
-        if faces.is_empty() {
-            lo = [0.0; 3];
-            hi = [0.0; 3];
-        }
-        // Keep the number of cells within a few times the number of faces.
-        let mut cell = cell.max(1e-300);
-        let max_cells = (4 * faces.len()).max(64) as f64;
-        loop {
-            let n: f64 = (0..3)
-                .map(|k| ((hi[k] - lo[k]) / cell).floor() + 1.0)
-                .product();
-            if n <= max_cells {
-                break;
-            }
-            cell *= 1.5;
-        }
-        let dims = [0, 1, 2].map(|k| ((hi[k] - lo[k]) / cell).floor() as usize + 1);
-        let inv_cell = 1.0 / cell;
-        let key = |c: Point3| -> usize {
-            let i = [0, 1, 2].map(|k| (((c[k] - lo[k]) * inv_cell) as usize).min(dims[k] - 1));
-            (i[2] * dims[1] + i[1]) * dims[0] + i[0]
-        };
-        let ncell = dims[0] * dims[1] * dims[2];
-        let mut keyed: Vec<(u32, u32)> = faces
-            .par_iter()
-            .map(|&f| (key(centroids[f as usize]) as u32, f))
-            .collect();
-        keyed.par_sort_unstable();
-        let mut offsets = vec![0u32; ncell + 1];
-        for &(k, _) in &keyed {
-            offsets[k as usize + 1] += 1;
-        }
-        for i in 0..ncell {
-            offsets[i + 1] += offsets[i];
-        }
-        FaceGrid {
-            origin: lo,
-            inv_cell,
-            dims,
-            offsets,
-            items: keyed
-                .into_iter()
-                .map(|(_, f)| Item {
-                    c: centroids[f as usize],
-                    n: em.normals[f as usize],
-                    area: em.areas[f as usize],
+/// The grid over `faces` (ascending ids) with cells of about `cell`.
+fn face_grid(em: &EdgeMesh, faces: &[u32], cell: f64) -> FaceGrid {
+    let items = faces
+        .iter()
+        .map(|&f| {
+            let i = f as usize;
+            (
+                em.centroids[i],
+                Item {
+                    n: em.normals[i],
+                    area: em.areas[i],
                     face: f,
-                })
-                .collect(),
-        }
-    }
-
-    /// Calls `f` for every face of the grid whose barycentre is within `r` of `q`.
-    fn for_each_within(&self, q: Point3, r: f64, mut f: impl FnMut(&Item, f64)) {
-        let r2 = r * r;
-        let cell_range = |k: usize| {
-            let a = ((q[k] - r - self.origin[k]) * self.inv_cell).floor();
-            let b = ((q[k] + r - self.origin[k]) * self.inv_cell).floor();
-            let last = self.dims[k] as f64 - 1.0;
-            if b < 0.0 || a > last {
-                None
-            } else {
-                Some((a.max(0.0) as usize, b.min(last) as usize))
-            }
-        };
-        let (Some(x), Some(y), Some(z)) = (cell_range(0), cell_range(1), cell_range(2)) else {
-            return;
-        };
-        for iz in z.0..=z.1 {
-            for iy in y.0..=y.1 {
-                let row = (iz * self.dims[1] + iy) * self.dims[0];
-                let s = self.offsets[row + x.0] as usize;
-                let e = self.offsets[row + x.1 + 1] as usize;
-                for it in &self.items[s..e] {
-                    let d2 = vec3::dist2(it.c, q);
-                    if d2 <= r2 {
-                        f(it, d2);
-                    }
-                }
-            }
-        }
-    }
+                },
+            )
+        })
+        .collect();
+    BallGrid::new(items, cell)
 }
 
 /// The level of a face: leading zero bits of a SplitMix64 hash of its id (level ≥ l holds a
@@ -365,7 +280,7 @@ pub fn tangent_angles(em: &EdgeMesh, params: &TangentParams) -> Result<TangentAn
             .filter(|&f| face_levels[f as usize] >= l && em.areas[f as usize] > 0.0)
             .collect();
         let rmax = scales.iter().map(|&s| radii[s]).fold(0.0, f64::max);
-        let grid = FaceGrid::new(em, faces, rmax / 2.0);
+        let grid = face_grid(em, &faces, rmax / 2.0);
         groups.push(Group { scales, grid });
     }
 
@@ -439,10 +354,10 @@ fn edge_angles(
         let rmax = radii[rmax_s];
         scratch.cand.clear();
         let cand = &mut scratch.cand;
-        g.grid.for_each_within(m, rmax, |it, d2| {
+        g.grid.for_each_within(m, rmax, |it, c, d2| {
             if it.face as usize != fa && it.face as usize != fb {
                 cand.push(Cand {
-                    sd: vec3::dot(vec3::sub(it.c, m), s),
+                    sd: vec3::dot(vec3::sub(c, m), s),
                     d2,
                     n: it.n,
                     area: it.area,
