@@ -134,6 +134,17 @@ impl CellGrid {
         }
     }
 
+    /// Centre of cell `c`.
+    #[inline]
+    pub fn cell_centre(&self, c: [i64; 3]) -> Point3 {
+        let h = 0.5 * self.cell_size;
+        [
+            self.lower(c[0], 0) + h,
+            self.lower(c[1], 1) + h,
+            self.lower(c[2], 2) + h,
+        ]
+    }
+
     /// Lower corner of cell `c` along axis `a`.
     #[inline]
     fn lower(&self, c: i64, a: usize) -> f64 {

@@ -100,6 +100,34 @@ impl Quantizer {
         })
     }
 
+    /// A quantiser with the same origin whose cells of some level `L` have side exactly `cell`
+    /// (`unit = cell / 2^L`, the largest `L` ≤ 21 whose cube of 2^21 units still covers this
+    /// one), with that level; `None` when no level can (`cell` finer than this quantiser's
+    /// unit, or not positive and finite).
+    pub fn with_cell(&self, cell: f64) -> Option<(Quantizer, u32)> {
+        if !(cell.is_finite() && cell > 0.0) {
+            return None;
+        }
+        let extent = self.extent();
+        let mut level = MORTON_BITS;
+        // Largest level with 2^(21 - level) * cell >= extent.
+        while level > 0 && ((1u64 << (MORTON_BITS - level)) as f64) * cell < extent {
+            level -= 1;
+        }
+        let unit = cell / (1u64 << level) as f64;
+        if unit * ((1u64 << MORTON_BITS) as f64) < extent || unit <= 0.0 || unit.is_nan() {
+            return None;
+        }
+        Some((
+            Quantizer {
+                origin: self.origin,
+                unit,
+                inv_unit: 1.0 / unit,
+            },
+            level,
+        ))
+    }
+
     /// The side of the quantised cube (2^21 units).
     pub fn extent(&self) -> f64 {
         self.unit * (1u64 << MORTON_BITS) as f64
@@ -164,6 +192,29 @@ mod tests {
         assert_eq!(morton_encode([0, 1, 0]), 2);
         assert_eq!(morton_encode([0, 0, 1]), 4);
         assert_eq!(morton_encode([2, 0, 0]), 8);
+    }
+
+    #[test]
+    fn fitted_quantiser_has_the_asked_cell_side() {
+        let pts: Vec<Point3> = vec![[0.0, 0.0, 0.0], [3.7, 1.0, -2.0], [1.0, 9.3, 0.5]];
+        let q = Quantizer::new(&pts).unwrap();
+        for cell in [0.013, 0.1, 0.77, 5.0, 50.0] {
+            let (f, level) = q.with_cell(cell).unwrap();
+            let side = f.unit * (1u64 << level) as f64;
+            assert!((side - cell).abs() <= 1e-12 * cell, "{cell}: {side}");
+            assert!(
+                f.extent() >= q.extent(),
+                "{cell}: the fitted cube must cover the box"
+            );
+            // Every point still quantises inside the cube.
+            for p in &pts {
+                assert!(f.quantize(p).iter().all(|&c| c <= MORTON_MAX));
+            }
+        }
+        // Finer than 2^21 cells over the box, or not a length: no fitted quantiser.
+        assert!(q.with_cell(q.extent() * 1e-7).is_none());
+        assert!(q.with_cell(0.0).is_none());
+        assert!(q.with_cell(f64::NAN).is_none());
     }
 
     #[test]
