@@ -1,12 +1,13 @@
 //! Scores the sharp-point detectors on the PCEDNet benchmark models in `../shared/data/points-gt`
 //! (median Matthews correlation coefficient of the sharp class, as the benchmark reports it).
 //!
-//! `cargo run --release -p crease --example sharp_pcednet -- [MEASURE] [raw] [q=0.99]`
+//! `cargo run --release -p crease --example sharp_pcednet -- [MEASURE] [raw] [nothin] [q=0.99]
+//! [scales=12,16,..] [reg=K,LAMBDA,ALPHA,SLOPE] [noauto] [sets=abc,abc-noisy,default]`
 
 use std::path::PathBuf;
 
 use crease::io::{read, ReadOptions};
-use crease::sharp::{detect_points, Measure, SharpParams};
+use crease::sharp::{Measure, SharpParams};
 
 fn mcc(pred: &[bool], truth: &[bool]) -> f64 {
     let (mut tp, mut fp, mut tn, mut fnn) = (0f64, 0f64, 0f64, 0f64);
@@ -29,6 +30,7 @@ fn mcc(pred: &[bool], truth: &[bool]) -> f64 {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut params = SharpParams::default();
+    let mut sets: Vec<String> = vec!["abc".into(), "abc-noisy".into(), "default".into()];
     for a in &args {
         if let Some(m) = Measure::ALL.iter().find(|m| m.name() == a) {
             params.measure = *m;
@@ -36,16 +38,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             params.pca_weight = crease::estimate::PcaWeight::Uniform;
         } else if a == "nothin" {
             params.thin = false;
+        } else if a == "noauto" {
+            params.auto_regularize = None;
         } else if a == "raw" {
             params.density_invariant = false;
         } else if let Some(q) = a.strip_prefix("q=") {
             params.otsu.upper_quantile = q.parse()?;
+        } else if let Some(r) = a.strip_prefix("reg=") {
+            let v: Vec<f64> = r.split(',').map(|x| x.parse()).collect::<Result<_, _>>()?;
+            params.regularize = Some(crease::sharp::Regularize {
+                k: v[0] as usize,
+                lambda: v[1],
+                line_reward: v[2],
+                slope: v[3],
+                ..Default::default()
+            });
+        } else if let Some(s) = a.strip_prefix("sets=") {
+            sets = s.split(',').map(String::from).collect();
         } else if let Some(s) = a.strip_prefix("scales=") {
             params.scales = Some(s.split(',').map(|x| x.parse()).collect::<Result<_, _>>()?);
         }
     }
+    let kmax = params
+        .scales
+        .as_ref()
+        .map_or(40, |s| s.iter().copied().max().unwrap_or(40))
+        .max(40);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/points-gt");
-    for set in ["abc", "abc-noisy", "default"] {
+    for set in &sets {
         let mut names: Vec<_> = std::fs::read_dir(root.join(set))?
             .filter_map(|e| e.ok().map(|e| e.path()))
             .collect();
@@ -60,15 +80,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .map(|c| matches!(c, [168, 0, 0] | [255, 0, 0]))
                 .collect();
             let t = std::time::Instant::now();
-            let r = detect_points(&cloud.positions, &params)?;
+            let nbrs = crease::spatial::knn(&cloud.positions, kmax)?;
+            let r = crease::sharp::detect_points_with(&cloud.positions, &nbrs, &params)?;
             let m = mcc(&r.sharp, &truth);
             println!(
-                "{set}/{:<22} n={:>6} gt={:>5} pred={:>6} mcc={m:.3} ({:.2}s) T={:?}",
+                "{set}/{:<22} n={:>6} gt={:>5} pred={:>6} mcc={m:.3} ({:.2}s) noise={:.3}{} T={:?}",
                 path.file_name().unwrap_or_default().to_string_lossy(),
                 truth.len(),
                 truth.iter().filter(|&&x| x).count(),
                 r.num_sharp(),
                 t.elapsed().as_secs_f64(),
+                r.noise_ratio.unwrap_or(0.0),
+                if r.regularized { " potts" } else { "" },
                 r.scales
                     .iter()
                     .map(|s| (s.normalized_threshold * 1000.0).round() / 1000.0)

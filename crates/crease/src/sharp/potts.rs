@@ -51,7 +51,9 @@
 //! (the Potts price erodes lines one or two points wide, which the reward only partly
 //! offsets), and stays far below the 0.40 hoped for: the per-point sharpness of the noisy
 //! models is too weak a data term. Weighting the line direction by max(0, ln sharpness)
-//! instead of the soft probability was worse (noisy 0.089–0.127). Hence not on by default.
+//! instead of the soft probability was worse (noisy 0.089–0.127). Hence it is applied only to
+//! clouds measured as noisy ([`super::SharpParams::auto_regularize`], setting
+//! [`Regularize::noisy`] = (10, 1, 16, 1)), where clean clouds keep the detector alone.
 
 use rayon::prelude::*;
 
@@ -75,6 +77,22 @@ pub struct Regularize {
     pub slope: f64,
     /// Neighbours giving the local line direction (default 16).
     pub k_dir: usize,
+}
+
+impl Regularize {
+    /// The setting applied automatically to noisy clouds
+    /// ([`super::SharpParams::auto_regularize`]): k = 10, λ = 1, α = 16, slope 1, the best noisy
+    /// median of the table in the module documentation (0.231), chosen there before the noise
+    /// switch existed (not re-tuned for it).
+    pub fn noisy() -> Self {
+        Regularize {
+            k: 10,
+            lambda: 1.0,
+            line_reward: 16.0,
+            slope: 1.0,
+            k_dir: 16,
+        }
+    }
 }
 
 impl Default for Regularize {
