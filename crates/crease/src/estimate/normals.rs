@@ -39,6 +39,7 @@
 //! 0.80 + 0.35 (sorted) to 0.51 (random) CPU s.
 
 use rayon::prelude::*;
+use wide::f64x4;
 
 use crate::geometry::{vec3, Point3, TriMesh};
 use crate::spatial::knn::knn_map;
@@ -205,21 +206,46 @@ pub fn estimate_normals(points: &[Point3], k: usize) -> Result<Vec<Point3>> {
 /// eigenvalues ascending normalised by Σμ).
 ///
 /// Two passes: the centroid and the mean squared distance to it from sums taken relative to `p`
-/// (small numbers, no cancellation to speak of), then the weights and the covariance.
+/// (small numbers, no cancellation to speak of), then the weights and the covariance. Both
+/// passes run four points at a time (SIMD lanes over p and its neighbours, the last group
+/// padded with zero-weight lanes): measured at 1M points (k = 20), the fit went from about a
+/// third of the fused kNN + PCA time to ... .
 #[inline]
 pub(crate) fn weighted_pca(p: Point3, nbrs: &[Point3], weight: PcaWeight) -> (Point3, [f64; 3]) {
     let m = (nbrs.len() + 1) as f64;
-    let (mut sx, mut sy, mut sz, mut s2) = (0.0, 0.0, 0.0, 0.0);
-    for q in nbrs {
-        let (dx, dy, dz) = (q[0] - p[0], q[1] - p[1], q[2] - p[2]);
-        sx += dx;
-        sy += dy;
-        sz += dz;
-        s2 += dx * dx + dy * dy + dz * dz;
+    let groups = (nbrs.len() + 1).div_ceil(4);
+    // Lane i of group g is point 4g + i of [p, nbrs...], relative to p (zero for padding).
+    let lanes = |g: usize| -> (f64x4, f64x4, f64x4) {
+        let mut x = [0.0; 4];
+        let mut y = [0.0; 4];
+        let mut z = [0.0; 4];
+        for i in 0..4 {
+            let j = 4 * g + i;
+            if j >= 1 {
+                if let Some(q) = nbrs.get(j - 1) {
+                    x[i] = q[0] - p[0];
+                    y[i] = q[1] - p[1];
+                    z[i] = q[2] - p[2];
+                }
+            }
+        }
+        (f64x4::new(x), f64x4::new(y), f64x4::new(z))
+    };
+    let (mut sx, mut sy, mut sz, mut s2) = (f64x4::ZERO, f64x4::ZERO, f64x4::ZERO, f64x4::ZERO);
+    for g in 0..groups {
+        let (x, y, z) = lanes(g);
+        sx += x;
+        sy += y;
+        sz += z;
+        s2 += x * x + y * y + z * z;
     }
     // Centroid relative to p, and Σ|q − c|² = Σ|q − p|² − m |c − p|².
-    let c = [sx / m, sy / m, sz / m];
-    let sum_d2 = (s2 - m * vec3::dot(c, c)).max(0.0);
+    let c = [
+        sx.reduce_add() / m,
+        sy.reduce_add() / m,
+        sz.reduce_add() / m,
+    ];
+    let sum_d2 = (s2.reduce_add() - m * vec3::dot(c, c)).max(0.0);
     let inv_s2 = match weight {
         PcaWeight::Uniform => 0.0,
         PcaWeight::GaussianFixed(s) => 1.0 / (s * s),
@@ -232,57 +258,72 @@ pub(crate) fn weighted_pca(p: Point3, nbrs: &[Point3], weight: PcaWeight) -> (Po
             }
         }
     };
-    let mut a = [0.0f64; 6]; // xx xy xz yy yz zz
-    let mut wsum = 0.0;
-    let mut add = |d: Point3| {
+    let (cx, cy, cz) = (f64x4::splat(c[0]), f64x4::splat(c[1]), f64x4::splat(c[2]));
+    let neg_inv_s2 = f64x4::splat(-inv_s2);
+    let total = nbrs.len() + 1;
+    let mut a = [f64x4::ZERO; 6]; // xx xy xz yy yz zz
+    let mut wsum = f64x4::ZERO;
+    for g in 0..groups {
+        let (x, y, z) = lanes(g);
+        let (dx, dy, dz) = (x - cx, y - cy, z - cz);
         let w = if inv_s2 > 0.0 {
-            exp_neg(-(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) * inv_s2)
+            exp_neg4((dx * dx + dy * dy + dz * dz) * neg_inv_s2)
         } else {
-            1.0
+            f64x4::ONE
+        };
+        // Padding lanes (past the last point) weigh nothing.
+        let w = if 4 * g + 4 > total {
+            let mut keep = [0.0; 4];
+            for (i, k) in keep.iter_mut().enumerate() {
+                *k = if 4 * g + i < total { 1.0 } else { 0.0 };
+            }
+            w * f64x4::new(keep)
+        } else {
+            w
         };
         wsum += w;
-        let (wx, wy, wz) = (w * d[0], w * d[1], w * d[2]);
-        a[0] += wx * d[0];
-        a[1] += wx * d[1];
-        a[2] += wx * d[2];
-        a[3] += wy * d[1];
-        a[4] += wy * d[2];
-        a[5] += wz * d[2];
-    };
-    add([-c[0], -c[1], -c[2]]);
-    for q in nbrs {
-        add([q[0] - p[0] - c[0], q[1] - p[1] - c[1], q[2] - p[2] - c[2]]);
+        let (wx, wy, wz) = (w * dx, w * dy, w * dz);
+        a[0] += wx * dx;
+        a[1] += wx * dy;
+        a[2] += wx * dz;
+        a[3] += wy * dy;
+        a[4] += wy * dz;
+        a[5] += wz * dz;
     }
+    let wsum = wsum.reduce_add();
+    let mut cov = a.map(f64x4::reduce_add);
     if wsum > 0.0 {
         let inv = 1.0 / wsum;
-        for v in &mut a {
+        for v in &mut cov {
             *v *= inv;
         }
     }
-    smallest_eigen(a)
+    smallest_eigen(cov)
 }
 
-/// e^x for x ≤ 0 to ~6e-9 relative (range reduction by ln 2 and a degree-7 Taylor polynomial
-/// on |r| ≤ ln2 / 2); 0 below −708. Several times faster than `f64::exp`, and weights need no
-/// more precision.
+/// e^x for x ≤ 0 on four lanes, to ~6e-9 relative (range reduction by ln 2 and a degree-7
+/// Taylor polynomial in Estrin form on |r| ≤ ln2 / 2; rounding to the nearest integer by adding
+/// 1.5·2^52); below −708 the result is e^−708 ≈ 3e−308, a weight of nothing. Several times
+/// faster than `f64::exp`, and weights need no more precision.
 #[inline]
-fn exp_neg(x: f64) -> f64 {
-    if x < -708.0 || x.is_nan() {
-        return 0.0;
-    }
-    // Round to nearest without a libm call: adding 1.5·2^52 drops the fraction bits.
+fn exp_neg4(x: f64x4) -> f64x4 {
     const MAGIC: f64 = 6755399441055744.0;
-    let nf = (x * std::f64::consts::LOG2_E + MAGIC) - MAGIC;
     const LN2_HI: f64 = 6.931_471_803_691_238e-1;
     const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
-    let r = (x - nf * LN2_HI) - nf * LN2_LO;
-    // Degree-7 Taylor polynomial in Estrin form (short dependency chains).
+    let x = x.max(f64x4::splat(-708.0));
+    let magic = f64x4::splat(MAGIC);
+    let nf = (x * f64x4::splat(std::f64::consts::LOG2_E) + magic) - magic;
+    let r = (x - nf * f64x4::splat(LN2_HI)) - nf * f64x4::splat(LN2_LO);
     let r2 = r * r;
     let r4 = r2 * r2;
-    let p = (1.0 + r)
-        + r2 * (0.5 + r * (1.0 / 6.0))
-        + r4 * ((1.0 / 24.0 + r * (1.0 / 120.0)) + r2 * (1.0 / 720.0 + r * (1.0 / 5040.0)));
-    p * f64::from_bits(((nf as i64 + 1023) as u64) << 52)
+    let s = |v: f64| f64x4::splat(v);
+    let p = (s(1.0) + r)
+        + r2 * (s(0.5) + r * s(1.0 / 6.0))
+        + r4 * ((s(1.0 / 24.0) + r * s(1.0 / 120.0)) + r2 * (s(1.0 / 720.0) + r * s(1.0 / 5040.0)));
+    let scale = nf
+        .to_array()
+        .map(|n| f64::from_bits(((n as i64 + 1023) as u64) << 52));
+    p * f64x4::new(scale)
 }
 
 /// Eigen-decomposition of the symmetric 3×3 matrix `[xx, xy, xz, yy, yz, zz]`: the unit
@@ -478,13 +519,17 @@ mod tests {
 
     #[test]
     fn fast_exp_accuracy() {
+        let exp_neg = |x: f64| exp_neg4(f64x4::new([x, 0.5 * x, 0.0, x])).to_array();
         for i in 0..=100_000 {
             let x = -(i as f64) * 1e-3;
-            let (a, b) = (exp_neg(x), x.exp());
+            let [a, h, one, a2] = exp_neg(x);
+            let (b, bh) = (x.exp(), (0.5 * x).exp());
             assert!((a - b).abs() <= 1e-8 * b, "{x}: {a} vs {b}");
+            assert!((h - bh).abs() <= 1e-8 * bh, "{x}: {h} vs {bh}");
+            assert_eq!((one, a2), (1.0, a));
         }
-        assert_eq!(exp_neg(-1000.0), 0.0);
-        assert_eq!(exp_neg(0.0), 1.0);
+        assert!(exp_neg(-1000.0)[0] < 1e-300);
+        assert_eq!(exp_neg(0.0)[0], 1.0);
     }
 
     #[test]

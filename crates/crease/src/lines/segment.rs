@@ -188,7 +188,7 @@ mod tests {
     #[test]
     fn smoothing_keeps_the_crease_and_removes_noise() {
         let n = 40;
-        let tilt = |i: usize| if i % 2 == 0 { 0.17 } else { -0.17 };
+        let tilt = |i: usize| if i.is_multiple_of(2) { 0.17 } else { -0.17 };
         let normals: Vec<Point3> = (0..n)
             .map(|i| {
                 let t: f64 = tilt(i);

@@ -737,7 +737,7 @@ fn build_block(grid: &CellGrid, c: [i64; 3], block: &mut Block) {
     // Padding: points far outside the block (their squared distances stay finite in f32
     // for any cell size, and they are never candidates).
     let far = (2.0 * grid.cell_size).max(1.0) as f32 * 1e6;
-    while block.x.len() % LANES != 0 {
+    while !block.x.len().is_multiple_of(LANES) {
         block.x.push(far);
         block.y.push(far);
         block.z.push(far);
