@@ -6,50 +6,60 @@
 //!
 //! # Algorithm
 //! The points are sorted along a Morton curve (21 bits per axis over the bounding box, parallel
-//! sort), and bucketed into a uniform grid whose cells are Morton prefixes (so the sort is done
-//! once), with a cell side close to the typical k-th neighbour distance. That distance is
-//! estimated before the grid exists, from windows of the Morton order (the k-th nearest point
-//! within a window of the sorted order bounds the true one from above; the median over 1024
-//! samples is used). Each query scans the shells of cells around its own cell, nearest shells
-//! first, keeping the k best candidates in a small sorted array, skipping cells farther than the
-//! current k-th candidate, and stops when the next shell cannot hold anything nearer. Queries run
-//! in Morton order (neighbouring queries touch the same cells, which stay in cache) and the rows
-//! are then gathered back into the input order. Points whose search would need more than a few
-//! shells (outliers, very uneven density) are finished by a k-d tree (kiddo) built only when
-//! such points exist. Ties are broken by input index everywhere, so the result equals brute force
-//! and does not depend on the thread count or the input order.
+//! sort). The typical k-th neighbour distance r_k is estimated from windows of that order (the
+//! k-th nearest point within a window of the sorted order bounds the true one from above; the
+//! median over 1024 samples is used). The points are then sorted again on a quantiser whose
+//! unit makes a Morton prefix a cell of side exactly 1.2 r_k, and bucketed into that uniform
+//! grid (cells are contiguous runs of the order, found through a hash table). Queries run in
+//! Morton order (neighbouring queries share cells, which stay in cache), in parallel tasks of
+//! consecutive ranks, and each result is written straight to its input position.
+//!
+//! **Block search** (`block_query`, almost every query). The points of the 3 x 3 x 3 cells
+//! around the query's cell are copied once per cell into a structure of arrays of f32
+//! coordinates relative to the cell's centre. Per query: the squared distances to all of them
+//! (eight lanes at a time); a threshold θ with at least k of them below it, narrowed from the
+//! bound the previous query gives (the largest distance from q to the previous query's
+//! neighbourhood) by interpolating vectorised counts (squared distances on a surface are spread
+//! about uniformly, so two or three counts leave k to k + 3 candidates); those candidates
+//! bucket-sorted by their f32 distance; exact f64 distances for them and an insertion pass on
+//! (distance, index). The f32 error of a squared distance within the block is bounded (2^-16
+//! cell², see `build_block`), so every true neighbour is among the candidates, and the answer
+//! is accepted only when θ plus that error lies inside the distance from q to the block's faces:
+//! the result is exact. Otherwise (≈ 0.1 % of the queries on surfaces) the shell search below
+//! answers.
+//!
+//! **Shell search** (`grid_query`). Shells of cells of growing Chebyshev radius around the
+//! query's cell, nearest shells first, keeping the k best candidates, skipping cells farther
+//! than the current k-th candidate, until the next shell cannot hold anything nearer. Points
+//! whose search would need more than a few shells (outliers, very uneven density) are finished
+//! by a k-d tree (kiddo) built only when such points exist. Ties are broken by input index
+//! everywhere, so the result equals brute force and does not depend on the thread count or the
+//! input order.
 //!
 //! [`knn_map`] runs the same search but hands each neighbourhood (indices, coordinates, squared
 //! distances) to a closure while it is in cache, and returns the closure's results in input
 //! order, with no n·k lists at all; [`knn`] is the same query loop writing rows.
 //!
-//! Per query: the previous query p of the same task bounds the k-th distance from above (the
-//! k-th smallest distance from q to p and its k neighbours, O(k): the largest or second largest
-//! of them), which prunes the 3 x 3 x 3 block of cells around q's cell; the candidates within
-//! the bound (≈ 2k on surfaces) are ranked on packed u64 keys (distance bits, slot in the low 12
-//! bits) and finished by an exact (distance, index) insertion pass; if the ball of the k-th
-//! distance leaves the block, only the cells of its bounding box outside the block are scanned.
-//!
-//! # Measured (release, 1M points on a unit cube's faces, k = 20, shared 2-core machine)
-//! Load average 2 to 5 from other jobs while measuring, so CPU time (user + system) is the
-//! comparable figure (`tests/normals.rs`, `timing_1m`, ignored by default; best of 3):
-//!
-//! | step                                              | 1 thread, CPU s | 2 threads, CPU s (wall) |
-//! |---------------------------------------------------|-----------------|-------------------------|
-//! | [`knn`] (CSR rows in input order)                 |                 | 0.80 to 0.84 (0.47)     |
-//! | `pca_normals_direct` ([`knn_map`] + PCA, fused)   | 1.14 to 1.22    | 1.12 to 1.18 (0.63)     |
-//!
-//! The fused path, random or Morton-sorted input alike, was 1.45 CPU s before this search's
-//! changes (O(k) seed instead of a selection: -5 %; one selection on packed u64 keys instead of
-//! selection + sort of tuples: -8 %; parallel scatter back to input order instead of a serial
-//! cycle walk: -55 ms wall). Tried and dropped: a per-thread cache of cell-table lookups (no
-//! gain), a 64-bucket distribution sort of the candidates (+10 %), selection before sorting
-//! when there are fewer than 64 candidates (+3 %). Earlier measurements: kiddo per point
-//! 21.5 CPU s random / 9.3 sorted; cell sides of 0.5x and 2x the estimated k-th neighbour
-//! distance 2.0 and 1.15 CPU s against 1.0 for 1x. Memory: the points in Morton order (24
-//! B/point), input indices (4 B/point), the cell table (≤ 32 B/point), plus for [`knn`] two n·k
-//! u32 buffers (160 MB at 1M, k = 20) and for [`knn_map`] only the n results; `crease normals`
-//! on 1M points (reading, fused PCA, writing) peaks at 156 MB resident.
+//! # Measured (release, 1M points on a unit cube's faces, k = 20, 2-core machine)
+//! The machine's speed varies by ±20 % from minute to minute (a shared host), so figures are
+//! best of several runs, and comparisons were run side by side
+//! (`cargo run --release -p crease --example normals_timing`, `scripts/compare-normals.sh`):
+//! * `pca_normals_direct` ([`knn_map`] + PCA) in `crease normals` on a Morton-sorted file:
+//!   1.17 s before the block search, 0.95 s after it and the vectorised PCA fit, peak memory 173
+//!   → 126 MB (no second n-item result buffer); random input order 1.29 → 1.28 s.
+//! * Instructions per query (callgrind, 100k points, one thread): the shell search ≈ 7000 for
+//!   kNN alone, the block search ≈ 4500; cells fitted to 1.2 r_k make 99.9 % of queries succeed
+//!   in the block, against 24 % with the power-of-two cells of the bounding box's unit (whose
+//!   side lands anywhere in 0.7 to 1.4 r_k).
+//! * Tried and dropped: a comparison sort of the candidates (quick- / insertion sort: 15 % of
+//!   the time, branch mispredictions), a full selection of the k-th f32 distance per query
+//!   (`select_nth_unstable` on ≈ 108 values: 16 % of the time; the count interpolation replaced
+//!   it). Earlier, for the shell search: kiddo per point 21.5 CPU s random / 9.3 sorted; a
+//!   per-thread cache of cell-table lookups (no gain); cell sides of 0.5x and 2x r_k slower
+//!   than 1x.
+//! * Memory: the points in Morton order (24 B/point), input indices (4 B/point), the cell table
+//!   (≤ 32 B/point), two (code, index) sorts (16 B/point each, one at a time), plus for [`knn`]
+//!   two n·k u32 buffers (160 MB at 1M, k = 20) and for [`knn_map`] only the n results.
 
 use std::sync::OnceLock;
 
