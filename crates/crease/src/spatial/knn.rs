@@ -678,6 +678,19 @@ fn count_le(d: &[f32x8], t: f32) -> usize {
         .sum::<u32>() as usize
 }
 
+/// Sorts a short, nearly sorted slice in place (elements move only past their out-of-order
+/// neighbours).
+#[inline]
+fn insertion_sort<T: Ord>(v: &mut [T]) {
+    for i in 1..v.len() {
+        let mut j = i;
+        while j > 0 && v[j] < v[j - 1] {
+            v.swap(j, j - 1);
+            j -= 1;
+        }
+    }
+}
+
 /// Buckets of [`bucket_sort`].
 const BUCKETS: usize = 32;
 
@@ -705,13 +718,7 @@ fn bucket_sort(keys: &[u64], top: f32, out: &mut Vec<u64>) {
         }
         start[b] += 1;
     }
-    for i in 1..out.len() {
-        let mut j = i;
-        while j > 0 && out[j] < out[j - 1] {
-            out.swap(j, j - 1);
-            j -= 1;
-        }
-    }
+    insertion_sort(out);
 }
 
 /// Fills `block` with the points of the cells within Chebyshev distance 1 of cell `c`.
@@ -898,13 +905,7 @@ fn block_query(grid: &CellGrid, r: usize, k: usize, scratch: &mut Scratch) -> bo
             pos as u32,
         )
     }));
-    for i in 1..sel.len() {
-        let mut j = i;
-        while j > 0 && sel[j] < sel[j - 1] {
-            sel.swap(j, j - 1);
-            j -= 1;
-        }
-    }
+    insertion_sort(sel);
     sel.truncate(k);
     scratch.prev.clear();
     scratch.prev.push(r as u32);
@@ -1084,13 +1085,7 @@ fn select_sorted(
             .iter()
             .map(|&key| cands[(key & SLOT_MASK) as usize]),
     );
-    for i in 1..sel.len() {
-        let mut j = i;
-        while j > 0 && sel[j] < sel[j - 1] {
-            sel.swap(j, j - 1);
-            j -= 1;
-        }
-    }
+    insertion_sort(sel);
     sel.truncate(k);
 }
 
