@@ -2,7 +2,7 @@
 //! index), prefixes, input order, thread-count independence, argument errors.
 
 use crease::geometry::Point3;
-use crease::spatial::knn::{knn_map, KnnQuery};
+use crease::spatial::knn::{knn_map, knn_map_set, KnnQuery};
 use crease::spatial::{knn, knn_with, knn_within, radius_neighbors, KnnMethod};
 use crease::synth::{sample_points, Noise, SampleParams, Shape};
 
@@ -104,11 +104,21 @@ struct Seen {
 }
 
 fn map_all(p: &[Point3], k: usize) -> Vec<Seen> {
-    knn_map(
+    map_with(p, k, true)
+}
+
+/// [`knn_map`] (`ordered`) or [`knn_map_set`], each neighbourhood recorded.
+fn map_with(p: &[Point3], k: usize, ordered: bool) -> Vec<Seen> {
+    let map = if ordered {
+        knn_map::<Seen, usize, fn() -> usize, fn(&mut usize, &KnnQuery) -> Seen>
+    } else {
+        knn_map_set::<Seen, usize, fn() -> usize, fn(&mut usize, &KnnQuery) -> Seen>
+    };
+    map(
         p,
         k,
         || 0usize,
-        |calls: &mut usize, q: &KnnQuery| {
+        |calls: &mut usize, q: &KnnQuery| -> Seen {
             *calls += 1;
             Seen {
                 index: q.index,
@@ -135,6 +145,20 @@ fn assert_knn_map_exact(p: &[Point3], k: usize, what: &str) {
         assert_eq!(s.neighbors, pts);
         let d: Vec<f64> = pts.iter().map(|q| d2(&p[i], q)).collect();
         assert_eq!(s.dist2, d);
+    }
+    // The set variant: the same neighbours in some order, the slices consistent.
+    for (i, s) in map_with(p, k, false).iter().enumerate() {
+        assert_eq!(s.index, i);
+        assert_eq!(s.point, p[i]);
+        let mut got = s.ids.clone();
+        got.sort_unstable();
+        let mut expect = brute_knn(p, i, k);
+        expect.sort_unstable();
+        assert_eq!(got, expect, "{what}: k = {k}, knn_map_set, point {i}");
+        for ((&id, q), &d) in s.ids.iter().zip(&s.neighbors).zip(&s.dist2) {
+            assert_eq!(*q, p[id as usize]);
+            assert_eq!(d, d2(&p[i], q));
+        }
     }
 }
 
@@ -278,6 +302,16 @@ fn thread_count_does_not_change_the_result() {
     let one = map(1);
     assert_eq!(one, map(2));
     assert_eq!(one, map(3));
+    let set = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| map_with(&p, 16, false))
+    };
+    let set1 = set(1);
+    assert_eq!(set1, set(2));
+    assert_eq!(set1, set(3));
     let nb = knn(&p, 16).unwrap();
     for (i, s) in one.iter().enumerate() {
         assert_eq!(s.ids.as_slice(), nb.of(i));

@@ -29,9 +29,10 @@
 //! product of two rows of CV − λ₀I), which is several times faster than nalgebra's iterative
 //! `SymmetricEigen` (see the `normals` benchmark) and agrees with it to ~1e-12 on well-separated
 //! eigenvalues (tested). [`pca_normals`] processes given neighbourhoods in input order in
-//! parallel; [`pca_normals_direct`] fuses the kNN search and the fit ([`knn_map`] visits the
-//! neighbourhoods in Morton order while they are in cache, no n·k lists), with the same
-//! result; both are identical whatever the thread count.
+//! parallel; [`pca_normals_direct`] fuses the kNN search and the fit ([`knn_map_set`] visits
+//! the neighbourhoods in Morton order while they are in cache, no n·k lists), with the same
+//! result up to rounding (the same neighbours, summed in another order); each is identical
+//! whatever the thread count.
 //!
 //! Measured on 1M points of a cube's faces at k = 20 (release, 2 threads, best of 3, side by
 //! side with PCL and Open3D by `scripts/compare-normals.sh`): `pca_normals_direct` in
@@ -39,10 +40,11 @@
 //! 2.70 s) and 1.28 s in random order (PCL 5.27 s, Open3D 16.7 s).
 
 use rayon::prelude::*;
-use wide::f64x4;
+use wide::bytemuck::cast;
+use wide::{f64x4, u64x4};
 
 use crate::geometry::{vec3, Point3, TriMesh};
-use crate::spatial::knn::knn_map;
+use crate::spatial::knn::knn_map_set;
 use crate::spatial::Neighborhoods;
 use crate::{Error, Result};
 
@@ -153,10 +155,11 @@ pub fn pca_normals(
 }
 
 /// Weighted-PCA normals (tran equation 1) of every point over its `params.k` nearest neighbours,
-/// searched on the fly: the same result as [`knn`](crate::spatial::knn()) followed by [`pca_normals`], without storing
-/// the neighbour lists (the neighbourhoods are visited in spatial order by
-/// [`crate::spatial::knn::knn_map`], which is also several times more cache friendly than
-/// [`pca_normals`]' input-order traversal).
+/// searched on the fly: the same result as [`knn`](crate::spatial::knn()) followed by
+/// [`pca_normals`] up to rounding, without storing the neighbour lists (the neighbourhoods are
+/// visited in spatial order by [`crate::spatial::knn::knn_map_set`], which is also several
+/// times more cache friendly than [`pca_normals`]' input-order traversal, and hands over the
+/// neighbour set unranked: the fit does not need the order).
 ///
 /// Errors as [`knn`](crate::spatial::knn()) (k = 0, fewer than k + 1 points, a non-finite coordinate) and on a Gaussian
 /// sigma that is not positive and finite.
@@ -164,7 +167,7 @@ pub fn pca_normals_direct(points: &[Point3], params: &PcaParams) -> Result<PcaRe
     check_weight(params.weight)?;
     let k = params.k;
     let weight = params.weight;
-    let fits: Vec<(Point3, [f64; 3])> = knn_map(
+    let fits: Vec<(Point3, [f64; 3])> = knn_map_set(
         points,
         k,
         || (),
@@ -216,22 +219,30 @@ pub fn estimate_normals(points: &[Point3], k: usize) -> Result<Vec<Point3>> {
 pub(crate) fn weighted_pca(p: Point3, nbrs: &[Point3], weight: PcaWeight) -> (Point3, [f64; 3]) {
     let m = (nbrs.len() + 1) as f64;
     let groups = (nbrs.len() + 1).div_ceil(4);
-    // Lane i of group g is point 4g + i of [p, nbrs...], relative to p (zero for padding).
+    // Lane i of group g is point 4g + i of [p, nbrs...], relative to p; padding lanes repeat p
+    // (zero). Group 0 is [p, n0, n1, n2], then whole chunks of four neighbours: no per-lane
+    // branches.
+    let (px, py, pz) = (f64x4::splat(p[0]), f64x4::splat(p[1]), f64x4::splat(p[2]));
+    let four = |a: [&Point3; 4]| -> (f64x4, f64x4, f64x4) {
+        (
+            f64x4::new([a[0][0], a[1][0], a[2][0], a[3][0]]) - px,
+            f64x4::new([a[0][1], a[1][1], a[2][1], a[3][1]]) - py,
+            f64x4::new([a[0][2], a[1][2], a[2][2], a[3][2]]) - pz,
+        )
+    };
+    let at = |j: usize| nbrs.get(j).unwrap_or(&p);
+    let tail = nbrs.get(3..).unwrap_or(&[]);
     let lanes = |g: usize| -> (f64x4, f64x4, f64x4) {
-        let mut x = [0.0; 4];
-        let mut y = [0.0; 4];
-        let mut z = [0.0; 4];
-        for i in 0..4 {
-            let j = 4 * g + i;
-            if j >= 1 {
-                if let Some(q) = nbrs.get(j - 1) {
-                    x[i] = q[0] - p[0];
-                    y[i] = q[1] - p[1];
-                    z[i] = q[2] - p[2];
-                }
+        if g == 0 {
+            return four([&p, at(0), at(1), at(2)]);
+        }
+        match tail.get(4 * (g - 1)..4 * g) {
+            Some([a, b, c, d]) => four([a, b, c, d]),
+            _ => {
+                let j = 3 + 4 * (g - 1);
+                four([at(j), at(j + 1), at(j + 2), at(j + 3)])
             }
         }
-        (f64x4::new(x), f64x4::new(y), f64x4::new(z))
     };
     let (mut sx, mut sy, mut sz, mut s2) = (f64x4::ZERO, f64x4::ZERO, f64x4::ZERO, f64x4::ZERO);
     for g in 0..groups {
@@ -314,7 +325,8 @@ fn exp_neg4(x: f64x4) -> f64x4 {
     const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
     let x = x.max(f64x4::splat(-708.0));
     let magic = f64x4::splat(MAGIC);
-    let nf = (x * f64x4::splat(std::f64::consts::LOG2_E) + magic) - magic;
+    let shifted = x * f64x4::splat(std::f64::consts::LOG2_E) + magic;
+    let nf = shifted - magic;
     let r = (x - nf * f64x4::splat(LN2_HI)) - nf * f64x4::splat(LN2_LO);
     let r2 = r * r;
     let r4 = r2 * r2;
@@ -322,10 +334,11 @@ fn exp_neg4(x: f64x4) -> f64x4 {
     let p = (s(1.0) + r)
         + r2 * (s(0.5) + r * s(1.0 / 6.0))
         + r4 * ((s(1.0 / 24.0) + r * s(1.0 / 120.0)) + r2 * (s(1.0 / 720.0) + r * s(1.0 / 5040.0)));
-    let scale = nf
-        .to_array()
-        .map(|n| f64::from_bits(((n as i64 + 1023) as u64) << 52));
-    p * f64x4::new(scale)
+    // 2^n from the bits of `shifted` = MAGIC + n (n in −1022..=0 sits in the low mantissa
+    // bits): (n + 1023) << 52 is the exponent field of 2^n, with integer lanes (a conversion
+    // of each lane to i64 took about ten instructions).
+    let bits = cast::<f64x4, u64x4>(shifted) + u64x4::splat(1023);
+    p * cast::<u64x4, f64x4>(bits << 52)
 }
 
 /// Eigen-decomposition of the symmetric 3×3 matrix `[xx, xy, xz, yy, yz, zz]`: the unit
