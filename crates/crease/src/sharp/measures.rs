@@ -130,13 +130,13 @@ pub(crate) fn local_pca_coords(
 }
 
 /// The projected distance or surface variation of one point at every scale at once:
-/// `coords[0]` is the point and `coords[1..]` its neighbours nearest first (at least the
-/// largest scale's count); `out[s]` receives the value over the point and its `scales[s]`
-/// nearest neighbours.
+/// `coords[0]` is the point and `coords[1..]` its neighbours nearest first; `out[s]` receives
+/// the value over `coords[..ends[s]]` (the point and its neighbours at scale s: the `scales[s]`
+/// nearest, or those of them that [`super::face`] keeps). `ends` must not decrease.
 #[inline]
 pub(crate) fn pca_measure_scales(
     coords: &[Point3],
-    scales: &[usize],
+    ends: &[usize],
     measure: Measure,
     weight: PcaWeight,
     density_invariant: bool,
@@ -144,8 +144,8 @@ pub(crate) fn pca_measure_scales(
     out: &mut [f64],
 ) {
     if weight != PcaWeight::Uniform {
-        for (o, &k) in out.iter_mut().zip(scales) {
-            let l = local_pca_coords(&coords[..(k + 1).min(coords.len())], weight, work);
+        for (o, &m) in out.iter_mut().zip(ends) {
+            let l = local_pca_coords(&coords[..m.min(coords.len())], weight, work);
             *o = pca_value(&l, None, measure, density_invariant);
         }
         return;
@@ -155,8 +155,12 @@ pub(crate) fn pca_measure_scales(
     let p = coords[0];
     let (mut s1, mut s2) = ([0.0f64; 3], [0.0f64; 6]);
     let mut next = 1usize;
-    for (o, &k) in out.iter_mut().zip(scales) {
-        let m = (k + 1).min(coords.len());
+    for (o, &m) in out.iter_mut().zip(ends) {
+        let m = m.min(coords.len());
+        if m < next {
+            // Scales given in decreasing order: start the sums again.
+            (s1, s2, next) = ([0.0; 3], [0.0; 6], 1);
+        }
         while next < m {
             let d = vec3::sub(coords[next], p);
             s1 = vec3::add(s1, d);
