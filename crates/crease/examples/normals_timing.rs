@@ -3,6 +3,10 @@
 //! best of R runs, I/O excluded.
 //!
 //! `cargo run --release -p crease --example normals_timing -- [N=1000000] [R=5]`
+//!
+//! With a file instead of N (`normals_timing FILE.ply R`), only the fused normals on that file's
+//! points, in its order, best of R in one process: the way `scripts/pcl_normals.cpp` times
+//! PCL and the Open3D part of `scripts/compare-normals.sh` times Open3D.
 
 use std::time::Instant;
 
@@ -38,11 +42,25 @@ fn best_of(reps: usize, mut f: impl FnMut()) -> (f64, f64) {
 
 fn main() -> Result<(), crease::Error> {
     let args: Vec<String> = std::env::args().collect();
+    let reps: usize = args.get(2).and_then(|v| v.parse().ok()).unwrap_or(5);
+    if let Some(path) = args.get(1).filter(|a| a.parse::<usize>().is_err()) {
+        let (geom, _) = crease::io::read(path, &crease::io::ReadOptions::default())?;
+        let pts = &geom.points.positions;
+        let (w, c) = best_of(reps, || {
+            let r = pca_normals_direct(pts, &PcaParams::default());
+            std::hint::black_box(&r);
+        });
+        println!(
+            "pca_normals_direct k=20 {path} ({} points, {} threads): {w:.3} s wall, {c:.2} s CPU (best of {reps})",
+            pts.len(),
+            rayon::current_num_threads()
+        );
+        return Ok(());
+    }
     let n: usize = args
         .get(1)
         .and_then(|v| v.parse().ok())
         .unwrap_or(1_000_000);
-    let reps: usize = args.get(2).and_then(|v| v.parse().ok()).unwrap_or(5);
     let part = sample_points(
         &Shape::default_cube(),
         &SampleParams {

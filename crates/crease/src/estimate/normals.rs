@@ -34,10 +34,10 @@
 //! result up to rounding (the same neighbours, summed in another order); each is identical
 //! whatever the thread count.
 //!
-//! Measured on 1M points of a cube's faces at k = 20 (release, 2 threads, best of 3, side by
-//! side with PCL and Open3D by `scripts/compare-normals.sh`): `pca_normals_direct` in
-//! `crease normals` 0.95 s on a Morton-sorted file (PCL `NormalEstimationOMP` 2.34 s, Open3D
-//! 2.70 s) and 1.28 s in random order (PCL 5.27 s, Open3D 16.7 s).
+//! Measured on 1M points of a cube's faces at k = 20 (release, 2 threads, best of 3 in one
+//! process, side by side with PCL and Open3D by `scripts/compare-normals.sh`):
+//! `pca_normals_direct` 0.587 s on a Morton-sorted file (PCL `NormalEstimationOMP` 1.65 s,
+//! Open3D 2.12 s) and 0.631 s in random order (PCL 4.01 s, Open3D 11.6 s).
 
 use rayon::prelude::*;
 use wide::bytemuck::cast;

@@ -44,15 +44,25 @@
 //! The machine's speed varies by ±20 % from minute to minute (a shared host), so figures are
 //! best of several runs, and comparisons were run side by side
 //! (`cargo run --release -p crease --example normals_timing`, `scripts/compare-normals.sh`):
-//! * `pca_normals_direct` ([`knn_map`] + PCA) in `crease normals` on a Morton-sorted file:
-//!   1.17 s before the block search, 0.95 s after it and the vectorised PCA fit, peak memory 173
-//!   → 126 MB (no second n-item result buffer); random input order 1.29 → 1.28 s.
+//! * `pca_normals_direct` ([`knn_map_set`] + PCA) on a Morton-sorted 1M-point file, best of 3
+//!   in one process: 0.587 s (PCL `NormalEstimationOMP` 1.65 s in the same run of
+//!   `scripts/compare-normals.sh`), random input order 0.631 s (PCL 4.01 s); peak memory of
+//!   `crease normals` 126 MB. On an earlier day, slower machine: the shell search 1.17 s, the
+//!   first block search 0.95 s (PCL 2.34 s).
 //! * Instructions per query (callgrind, 100k points, one thread): the shell search ≈ 7000 for
-//!   kNN alone, the block search ≈ 4500; cells fitted to 1.2 r_k make 99.9 % of queries succeed
-//!   in the block, against 24 % with the power-of-two cells of the bounding box's unit (whose
-//!   side lands anywhere in 0.7 to 1.4 r_k).
-//! * Tried and dropped: a comparison sort of the candidates (quick- / insertion sort: 15 % of
-//!   the time, branch mispredictions), a full selection of the k-th f32 distance per query
+//!   kNN alone; the block search 6340 ranked at first, now 4890 ranked ([`knn`], [`knn_map`])
+//!   and 3810 for the unranked set ([`knn_map_set`]). What took the difference, by
+//!   instruction-level profiles: f32→usize bucket indices (a dozen instructions each on
+//!   baseline x86-64), bit counting without `popcnt`, a store-forwarding stall on comparing
+//!   cell coordinates and another on masking the query's own lane, stopping the threshold at
+//!   k + 3 candidates (each spare costs an exact distance and a removal), re-measuring the
+//!   previous neighbourhood for the starting bound. Cells fitted to 1.2 r_k make 99.9 % of
+//!   queries succeed in the block, against 24 % with the power-of-two cells of the bounding
+//!   box's unit (whose side lands anywhere in 0.7 to 1.4 r_k).
+//! * Tried and dropped: an AVX2 version of the block search by function multiversioning with
+//!   plain array loops for the compiler to vectorise (the loops stayed scalar or 4-wide: more
+//!   instructions than the `wide` SSE2 code), a comparison sort of the candidates (quick- /
+//!   insertion sort: 15 % of the time, branch mispredictions), a full selection of the k-th f32 distance per query
 //!   (`select_nth_unstable` on ≈ 108 values: 16 % of the time; the count interpolation replaced
 //!   it). Earlier, for the shell search: kiddo per point 21.5 CPU s random / 9.3 sorted; a
 //!   per-thread cache of cell-table lookups (no gain); cell sides of 0.5x and 2x r_k slower
