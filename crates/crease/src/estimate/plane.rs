@@ -110,3 +110,61 @@ mod tests {
         assert!(fit_plane(pts[..2].iter().copied()).is_none());
     }
 }
+
+/// First and second moments of a point set about one of its points p (the origin, which counts
+/// as a point at offset zero): taking them about p rather than about the coordinate origin
+/// keeps the numbers small, so the covariance Σ(d dᵀ)/m − c cᵀ loses little to cancellation.
+/// Used where a uniform PCA runs per point over neighbourhoods (sharp-feature measures, noise
+/// estimate, small-scale normals).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Moments {
+    s1: [f64; 3],
+    /// xx xy xz yy yz zz
+    s2: [f64; 6],
+    m: usize,
+}
+
+impl Moments {
+    /// The moments of p alone.
+    #[inline]
+    pub(crate) fn origin() -> Self {
+        Moments {
+            s1: [0.0; 3],
+            s2: [0.0; 6],
+            m: 1,
+        }
+    }
+
+    /// Adds the point at offset `d` from p.
+    #[inline]
+    pub(crate) fn add(&mut self, d: Point3) {
+        self.s1 = [self.s1[0] + d[0], self.s1[1] + d[1], self.s1[2] + d[2]];
+        self.s2[0] += d[0] * d[0];
+        self.s2[1] += d[0] * d[1];
+        self.s2[2] += d[0] * d[2];
+        self.s2[3] += d[1] * d[1];
+        self.s2[4] += d[1] * d[2];
+        self.s2[5] += d[2] * d[2];
+        self.m += 1;
+    }
+
+    /// The centroid's offset from p and the covariance `[xx, xy, xz, yy, yz, zz]` (divided by
+    /// the number of points, p included).
+    #[inline]
+    pub(crate) fn centroid_covariance(&self) -> (Point3, [f64; 6]) {
+        let inv = 1.0 / self.m as f64;
+        let c = [self.s1[0] * inv, self.s1[1] * inv, self.s1[2] * inv];
+        let s2 = &self.s2;
+        (
+            c,
+            [
+                s2[0] * inv - c[0] * c[0],
+                s2[1] * inv - c[0] * c[1],
+                s2[2] * inv - c[0] * c[2],
+                s2[3] * inv - c[1] * c[1],
+                s2[4] * inv - c[1] * c[2],
+                s2[5] * inv - c[2] * c[2],
+            ],
+        )
+    }
+}

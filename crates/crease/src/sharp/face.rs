@@ -50,6 +50,7 @@
 use rayon::prelude::*;
 
 use crate::estimate::normals::smallest_eigen;
+use crate::estimate::plane::Moments;
 use crate::geometry::{vec3, Point3};
 use crate::spatial::Neighborhoods;
 
@@ -67,29 +68,11 @@ pub const CHORD_DEG: f64 = 15.0;
 /// Uniform PCA normal of `p` and the points of `q` (moments about `p`); `[0, 0, 1]` when
 /// degenerate.
 fn plane_normal(p: Point3, q: impl Iterator<Item = Point3>) -> Point3 {
-    let (mut s1, mut s2, mut m) = ([0.0f64; 3], [0.0f64; 6], 1usize);
+    let mut mo = Moments::origin();
     for x in q {
-        let d = vec3::sub(x, p);
-        s1 = vec3::add(s1, d);
-        s2[0] += d[0] * d[0];
-        s2[1] += d[0] * d[1];
-        s2[2] += d[0] * d[2];
-        s2[3] += d[1] * d[1];
-        s2[4] += d[1] * d[2];
-        s2[5] += d[2] * d[2];
-        m += 1;
+        mo.add(vec3::sub(x, p));
     }
-    let inv = 1.0 / m as f64;
-    let c = vec3::scale(s1, inv);
-    let cov = [
-        s2[0] * inv - c[0] * c[0],
-        s2[1] * inv - c[0] * c[1],
-        s2[2] * inv - c[0] * c[2],
-        s2[3] * inv - c[1] * c[1],
-        s2[4] * inv - c[1] * c[2],
-        s2[5] * inv - c[2] * c[2],
-    ];
-    smallest_eigen(cov).0
+    smallest_eigen(mo.centroid_covariance().1).0
 }
 
 /// The small-scale normals m_i of the one-face test (see the module documentation), in input

@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use crate::estimate::curvature::fit_point;
 use crate::estimate::normals::{smallest_eigen, weighted_pca};
+use crate::estimate::plane::Moments;
 use crate::estimate::PcaWeight;
 use crate::geometry::{vec3, Point3};
 
@@ -153,35 +154,19 @@ pub(crate) fn pca_measure_scales(
     // Uniform weights: the nested neighbourhoods' moments are prefix sums, so every scale costs
     // one 3 x 3 eigenproblem. Moments are taken about the point itself for precision.
     let p = coords[0];
-    let (mut s1, mut s2) = ([0.0f64; 3], [0.0f64; 6]);
+    let mut mo = Moments::origin();
     let mut next = 1usize;
     for (o, &m) in out.iter_mut().zip(ends) {
         let m = m.min(coords.len());
         if m < next {
             // Scales given in decreasing order: start the sums again.
-            (s1, s2, next) = ([0.0; 3], [0.0; 6], 1);
+            (mo, next) = (Moments::origin(), 1);
         }
         while next < m {
-            let d = vec3::sub(coords[next], p);
-            s1 = vec3::add(s1, d);
-            s2[0] += d[0] * d[0];
-            s2[1] += d[0] * d[1];
-            s2[2] += d[0] * d[2];
-            s2[3] += d[1] * d[1];
-            s2[4] += d[1] * d[2];
-            s2[5] += d[2] * d[2];
+            mo.add(vec3::sub(coords[next], p));
             next += 1;
         }
-        let inv = 1.0 / m as f64;
-        let c = vec3::scale(s1, inv);
-        let cov = [
-            s2[0] * inv - c[0] * c[0],
-            s2[1] * inv - c[0] * c[1],
-            s2[2] * inv - c[0] * c[2],
-            s2[3] * inv - c[1] * c[1],
-            s2[4] * inv - c[1] * c[2],
-            s2[5] * inv - c[2] * c[2],
-        ];
+        let (c, cov) = mo.centroid_covariance();
         let (normal, eigenvalues) = smallest_eigen(cov);
         let rms_radius = (cov[0] + cov[3] + cov[5]).max(0.0).sqrt();
         let offset = vec3::scale(c, -1.0);

@@ -27,6 +27,7 @@
 use rayon::prelude::*;
 
 use crate::estimate::normals::smallest_eigen;
+use crate::estimate::plane::Moments;
 use crate::geometry::{vec3, Point3};
 use crate::spatial::Neighborhoods;
 
@@ -66,28 +67,12 @@ pub fn noise_ratio(points: &[Point3], nbrs: &Neighborhoods) -> f64 {
             let nn = row
                 .first()
                 .map_or(0.0, |&j| vec3::dist(p, points[j as usize]));
-            let (mut s1, mut s2) = ([0.0f64; 3], [0.0f64; 6]);
-            for &j in row {
-                let d = vec3::sub(points[j as usize], p);
-                s1 = vec3::add(s1, d);
-                s2[0] += d[0] * d[0];
-                s2[1] += d[0] * d[1];
-                s2[2] += d[0] * d[2];
-                s2[3] += d[1] * d[1];
-                s2[4] += d[1] * d[2];
-                s2[5] += d[2] * d[2];
-            }
             // The point itself is the origin of the moments (one of the row.len() + 1 points).
-            let inv = 1.0 / (row.len() + 1) as f64;
-            let c = vec3::scale(s1, inv);
-            let cov = [
-                s2[0] * inv - c[0] * c[0],
-                s2[1] * inv - c[0] * c[1],
-                s2[2] * inv - c[0] * c[2],
-                s2[3] * inv - c[1] * c[1],
-                s2[4] * inv - c[1] * c[2],
-                s2[5] * inv - c[2] * c[2],
-            ];
+            let mut mo = Moments::origin();
+            for &j in row {
+                mo.add(vec3::sub(points[j as usize], p));
+            }
+            let (_, cov) = mo.centroid_covariance();
             let (_, eig) = smallest_eigen(cov);
             let r = eig[0].max(0.0).sqrt();
             (if r.is_finite() { r } else { 0.0 }, nn)
