@@ -157,12 +157,20 @@ pub fn run(g: &Global, a: &SharpArgs) -> anyhow::Result<()> {
                 kmax + 1
             );
         }
-        // One kNN query at the largest scale serves every scale; timed apart for --json.
+        // One kNN query at the largest scale serves every scale; timed apart for --json. The
+        // detection runs on the points in Morton order (cache-friendly neighbour reads, see
+        // `crease::sharp::spatial_order`) and its result is mapped back to the input order.
         let t = Instant::now();
-        let nbrs = crease::spatial::knn(&geom.points.positions, kmax)
+        let pos = &geom.points.positions;
+        let spatial = crease::sharp::spatial_order(pos);
+        let pts = spatial.as_ref().map_or(pos, |(_, sorted)| sorted);
+        let nbrs = crease::spatial::knn(pts, kmax)
             .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
         knn_seconds = Some(t.elapsed().as_secs_f64());
-        detect_points_with(&geom.points.positions, &nbrs, &params)
+        detect_points_with(pts, &nbrs, &params).and_then(|r| match &spatial {
+            Some((order, _)) => r.to_input_order(order),
+            None => Ok(r),
+        })
     }
     .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
     stage.finish();

@@ -106,7 +106,7 @@ use rayon::prelude::*;
 use crate::estimate::normals::{mesh_vertex_normals, PcaWeight, Weighting};
 use crate::geometry::{MeshTopology, Point3, TriMesh};
 use crate::spatial::mesh_rings::vertex_k_rings_layered;
-use crate::spatial::{knn, Neighborhoods};
+use crate::spatial::{knn, morton_order, Neighborhoods};
 use crate::threshold::{otsu, OtsuParams};
 use crate::{Error, Result};
 
@@ -220,6 +220,46 @@ impl SharpResult {
     pub fn num_sharp(&self) -> usize {
         self.sharp.iter().filter(|&&s| s).count()
     }
+
+    /// The result of a detection run on `points` permuted by `order` (point r of the run is
+    /// input point `order[r]`, see [`spatial_order`]), back in input order.
+    pub fn to_input_order(mut self, order: &[u32]) -> Result<SharpResult> {
+        if order.len() != self.sharp.len() {
+            return Err(Error::InvalidArgument(format!(
+                "sharp features: a permutation of {} points for {} results",
+                order.len(),
+                self.sharp.len()
+            )));
+        }
+        let mut sharp = vec![false; order.len()];
+        let mut sharpness = vec![0.0; order.len()];
+        for (r, &i) in order.iter().enumerate() {
+            sharp[i as usize] = self.sharp[r];
+            sharpness[i as usize] = self.sharpness[r];
+        }
+        self.sharp = sharp;
+        self.sharpness = sharpness;
+        Ok(self)
+    }
+}
+
+/// The points along the Morton curve, with `order[r]` = the input index of sorted point r
+/// (`None` when there is no order, e.g. a non-finite coordinate, which the kNN then reports).
+///
+/// Every per-point pass of the cloud detector reads the coordinates of 12 to 40 neighbours;
+/// with the points in input order a scan in sampling (random) order misses the cache on
+/// almost every one of them (measured with perf on 1M points of `crease synth
+/// fillet-chamfer-cone`: one load in the measure pass took 18 % of the detection's samples).
+/// Run on Morton-sorted points, neighbours are mostly in cache; [`detect_points`] does this and
+/// maps the result back ([`SharpResult::to_input_order`]). Ties between equidistant neighbours
+/// are then broken by Morton rank instead of input index.
+pub fn spatial_order(points: &[Point3]) -> Option<(Vec<u32>, Vec<Point3>)> {
+    let order = morton_order(points);
+    if order.len() != points.len() {
+        return None;
+    }
+    let sorted = order.par_iter().map(|&i| points[i as usize]).collect();
+    Some((order, sorted))
 }
 
 fn check_scales(scales: &[usize], what: &str) -> Result<()> {
@@ -245,8 +285,16 @@ pub fn detect_points(points: &[Point3], params: &SharpParams) -> Result<SharpRes
         .unwrap_or_else(|| CLOUD_SCALES.to_vec());
     check_scales(&scales, "neighbourhood sizes")?;
     let kmax = scales.iter().copied().max().unwrap_or(1);
-    let nbrs = knn(points, kmax)?;
-    detect_points_with(points, &nbrs, params)
+    match spatial_order(points) {
+        Some((order, sorted)) => {
+            let nbrs = knn(&sorted, kmax)?;
+            detect_points_with(&sorted, &nbrs, params)?.to_input_order(&order)
+        }
+        None => {
+            let nbrs = knn(points, kmax)?;
+            detect_points_with(points, &nbrs, params)
+        }
+    }
 }
 
 /// [`detect_points`] from precomputed k-nearest-neighbour lists (at least the largest scale).
