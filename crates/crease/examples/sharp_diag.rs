@@ -5,6 +5,7 @@
 
 use std::path::PathBuf;
 
+use crease::eval::truth::{class_of_color, PointClass};
 use crease::geometry::{average_spacing, vec3, PointCloud};
 use crease::io::{read, write, Geometry, ReadOptions, WriteOptions};
 use crease::sharp::{detect_points, SharpParams};
@@ -79,7 +80,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let colors = cloud.colors.clone().ok_or("no colours")?;
             let truth: Vec<bool> = colors
                 .iter()
-                .map(|c| matches!(c, [168, 0, 0] | [255, 0, 0]))
+                .map(|c| class_of_color(*c) == Some(PointClass::Sharp))
                 .collect();
             let pts = &cloud.positions;
             let h = average_spacing(pts).ok_or("spacing")?;

@@ -6,6 +6,7 @@
 
 use std::path::PathBuf;
 
+use crease::eval::truth::{class_of_color, PointClass};
 use crease::io::{read, ReadOptions};
 use crease::sharp::{Measure, SharpParams};
 
@@ -77,7 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let colors = cloud.colors.clone().ok_or("no colours")?;
             let truth: Vec<bool> = colors
                 .iter()
-                .map(|c| matches!(c, [168, 0, 0] | [255, 0, 0]))
+                .map(|c| class_of_color(*c) == Some(PointClass::Sharp))
                 .collect();
             let t = std::time::Instant::now();
             let nbrs = crease::spatial::knn(&cloud.positions, kmax)?;

@@ -6,6 +6,7 @@
 
 use std::path::PathBuf;
 
+use crease::eval::truth::{class_of_color, PointClass};
 use crease::geometry::{average_spacing, vec3};
 use crease::io::{read, ReadOptions};
 use crease::spatial::knn;
@@ -25,7 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let normals = cloud.normals.clone().ok_or("no normals")?;
         let truth: Vec<bool> = colors
             .iter()
-            .map(|c| matches!(c, [168, 0, 0] | [255, 0, 0]))
+            .map(|c| class_of_color(*c) == Some(PointClass::Sharp))
             .collect();
         let pts = &cloud.positions;
         let h = average_spacing(pts).ok_or("spacing")?;
