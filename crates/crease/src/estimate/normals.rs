@@ -29,7 +29,7 @@
 //! product of two rows of CV − λ₀I), which is several times faster than nalgebra's iterative
 //! `SymmetricEigen` (see the `normals` benchmark) and agrees with it to ~1e-12 on well-separated
 //! eigenvalues (tested). [`pca_normals`] processes given neighbourhoods in input order in
-//! parallel; [`pca_normals_direct`] fuses the kNN search and the fit ([`knn_map_set`] visits
+//! parallel; [`pca_normals_direct`] fuses the kNN search and the fit ([`knn_map_set_unzip`] visits
 //! the neighbourhoods in Morton order while they are in cache, no n·k lists), with the same
 //! result up to rounding (the same neighbours, summed in another order); each is identical
 //! whatever the thread count.
@@ -44,7 +44,7 @@ use wide::bytemuck::cast;
 use wide::{f64x4, u64x4};
 
 use crate::geometry::{vec3, Point3, TriMesh};
-use crate::spatial::knn::knn_map_set;
+use crate::spatial::knn::knn_map_set_unzip;
 use crate::spatial::Neighborhoods;
 use crate::{Error, Result};
 
@@ -167,13 +167,12 @@ pub fn pca_normals_direct(points: &[Point3], params: &PcaParams) -> Result<PcaRe
     check_weight(params.weight)?;
     let k = params.k;
     let weight = params.weight;
-    let fits: Vec<(Point3, [f64; 3])> = knn_map_set(
+    let (normals, eigenvalues) = knn_map_set_unzip(
         points,
         k,
         || (),
         |_, q| weighted_pca(q.point, q.neighbors, weight),
     )?;
-    let (normals, eigenvalues) = fits.into_par_iter().unzip();
     Ok(PcaResult {
         normals,
         eigenvalues,
@@ -368,9 +367,7 @@ pub fn smallest_eigen(a: [f64; 6]) -> (Point3, [f64; 3]) {
     let det = cxx * (cyy * czz - cyz * cyz) - cxy * (cxy * czz - cyz * cxz)
         + cxz * (cxy * cyz - cyy * cxz);
     let r = (0.5 * det).clamp(-1.0, 1.0);
-    let phi = r.acos() / 3.0;
-    let l_max = q + 2.0 * p * phi.cos();
-    let l_min = q + 2.0 * p * (phi + 2.0 * std::f64::consts::FRAC_PI_3).cos();
+    let l_min = q + p * smallest_root(r);
     let r0 = [xx - l_min, xy, xz];
     let r1 = [xy, yy - l_min, yz];
     let r2 = [xz, yz, zz - l_min];
@@ -404,15 +401,47 @@ pub fn smallest_eigen(a: [f64; 6]) -> (Point3, [f64; 3]) {
         any_orthogonal(big)
     };
     // λ0 as the Rayleigh quotient of the normal (accurate to rounding even when λ0 ≈ λ1, where
-    // the trigonometric formula loses half the digits), λ2 from the formula (accurate unless
-    // λ1 ≈ λ2, and then to ~1e-8 relative), λ1 from the trace.
+    // the closed form loses half the digits); λ1 and λ2 as the roots of the quadratic left once
+    // λ0 is known (sum 3q − λ0, product the sum of the principal 2 × 2 minors − λ0 (λ1 + λ2)):
+    // accurate unless λ1 ≈ λ2, and then to ~1e-8 relative, like the trigonometric formula.
     let [nx, ny, nz] = normal;
     let l0 = nx * (xx * nx + xy * ny + xz * nz)
         + ny * (xy * nx + yy * ny + yz * nz)
         + nz * (xz * nx + yz * ny + zz * nz);
-    let l2 = l_max.max(l0);
-    let l1 = (3.0 * q - l0 - l2).clamp(l0, l2);
+    let sum = 3.0 * q - l0;
+    let minors = xx * yy - xy * xy + xx * zz - xz * xz + yy * zz - yz * yz;
+    let product = minors - l0 * sum;
+    let l2 = (0.5 * (sum + (sum * sum - 4.0 * product).max(0.0).sqrt())).max(l0);
+    let l1 = (sum - l2).clamp(l0, l2);
     (normal, [l0 * scale, l1 * scale, l2 * scale])
+}
+
+/// The smallest root of β³ − 3β − 2r (r in [−1, 1]): the smallest eigenvalue of the matrix
+/// C = (A − qI)/p of [`smallest_eigen`], whose characteristic polynomial this is (trace 0,
+/// tr C² = 6, det C = 2r), in [−2, −1].
+///
+/// Smith's formula gives it as 2 cos((acos r + 2π)/3); the acos and the cos cost 5 % of the
+/// fused kNN + PCA normals (perf, 1M points). Instead: as a function of w = √((1 − r)/2) the
+/// root is smooth on [0, 1] (the square-root branch point at the double root r = 1 becomes
+/// linear), and a degree-4 polynomial (Chebyshev fit) is within 4e-5 of it; three Newton steps
+/// then reach rounding (the error squares at each step, times f''/2f' ≤ 1.2 for w ≥ 0.25 and
+/// ≤ 45 for w ≥ 0.02). Below w = 0.02 (λ0 and λ1 within about 0.1 % of the spread of the
+/// eigenvalues, where the normal is ill-defined anyway and Newton slows) the trigonometric
+/// formula is used.
+#[inline]
+fn smallest_root(r: f64) -> f64 {
+    let w = (0.5 * (1.0 - r)).max(0.0).sqrt();
+    if w < 0.02 {
+        return 2.0 * ((r.acos() + 2.0 * std::f64::consts::PI) / 3.0).cos();
+    }
+    let mut b = -1.000_038_318_485_340_3
+        + w * (-1.153_472_967_059_816_3
+            + w * (0.212_707_344_799_025_87
+                + w * (-0.076_665_054_090_380_6 + w * 0.017_497_932_943_738_304)));
+    for _ in 0..3 {
+        b -= (b * (b * b - 3.0) - 2.0 * r) / (3.0 * (b * b - 1.0));
+    }
+    b
 }
 
 /// A unit vector orthogonal to `v` (`[0, 0, 1]` if `v` is zero).
@@ -529,6 +558,21 @@ mod tests {
             let res = (m * v - v * ev[0]).norm();
             let gap = (l[1] - l[0]).max(1e-300);
             assert!(res < 1e-10 || gap < 1e-6, "residual {res} gap {gap}");
+        }
+    }
+
+    #[test]
+    fn smallest_root_matches_smith() {
+        for i in 0..=200_000 {
+            let r = -1.0 + 2.0 * i as f64 / 200_000.0;
+            let smith = 2.0 * ((r.acos() + 2.0 * std::f64::consts::PI) / 3.0).cos();
+            let b = smallest_root(r);
+            // Within rounding of the root (the formula itself is only that accurate).
+            assert!((b - smith).abs() < 1e-13, "r {r}: {b} vs {smith}");
+            assert!(
+                (b * (b * b - 3.0) - 2.0 * r).abs() < 1e-14,
+                "r {r}: residual"
+            );
         }
     }
 

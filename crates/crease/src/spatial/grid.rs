@@ -8,6 +8,8 @@
 //! query's cell and stop as soon as the shell's outer boundary is farther than the current k-th
 //! neighbour, so the results are exact.
 
+use rayon::prelude::*;
+
 use crate::geometry::Point3;
 
 use super::morton::{morton_encode, Quantizer, MORTON_BITS, MORTON_MAX};
@@ -51,8 +53,13 @@ impl CellGrid {
         let level = level.min(MORTON_BITS);
         let shift_code = 3 * level;
         let cell_key = |c: u64| if shift_code >= 64 { 0 } else { c >> shift_code };
-        let sorted_points: Vec<Point3> = sorted.iter().map(|&(_, i)| points[i as usize]).collect();
-        let ids: Vec<u32> = sorted.iter().map(|&(_, i)| i).collect();
+        // In parallel: gathering 1M points in sorted order, a read from anywhere in the input
+        // each, took 10 to 20 ms on one thread.
+        let sorted_points: Vec<Point3> = sorted
+            .par_iter()
+            .map(|&(_, i)| points[i as usize])
+            .collect();
+        let ids: Vec<u32> = sorted.par_iter().map(|&(_, i)| i).collect();
         // Runs of equal cell keys.
         let mut cells: Vec<Slot> = Vec::new();
         let mut start = 0usize;

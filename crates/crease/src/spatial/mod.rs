@@ -11,7 +11,9 @@ pub mod ring;
 
 pub use graph::Adjacency;
 pub use kdtree::KdIndex;
-pub use knn::{knn, knn_map, knn_map_set, knn_with, KnnMethod, KnnQuery, Neighborhoods};
+pub use knn::{
+    knn, knn_map, knn_map_set, knn_map_set_unzip, knn_with, KnnMethod, KnnQuery, Neighborhoods,
+};
 pub use morton::morton_order;
 pub use radius::{knn_within, radius_neighbors};
 pub use ring::{delaunay_rings, RingParams, Rings};

@@ -162,6 +162,59 @@ pub fn morton_sorted(points: &[Point3], quantizer: &Quantizer) -> Vec<(u64, u32)
     keys
 }
 
+/// (Morton code, index) of every point, sorted by the cell of side 2^`level` units (the code
+/// shifted right by 3·level), in input order within a cell: all that a [`super::grid::CellGrid`]
+/// of that level needs, as the points of each cell are then contiguous and the cells in Morton
+/// order.
+///
+/// A stable least-significant-digit radix sort on the cell key alone, which has far fewer bits
+/// than the code at the cell sizes of a neighbour search (8 per axis for 1M points on a cube's
+/// faces: two passes of 12 bits), instead of a comparison sort of the whole 63-bit code.
+/// Measured on 1M cube points in sampling order, 5 runs: 25 to 42 ms for [`morton_sorted`],
+/// 16 to 22 ms for this. Stable, so the result does not depend on how the work is split.
+pub(crate) fn cell_sorted(points: &[Point3], quantizer: &Quantizer, level: u32) -> Vec<(u64, u32)> {
+    let shift = 3 * level.min(MORTON_BITS);
+    let cell = |c: u64| if shift >= 64 { 0 } else { c >> shift };
+    let mut keys: Vec<(u64, u32)> = points
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| (quantizer.code(p), i as u32))
+        .collect();
+    let top = keys.par_iter().map(|&(c, _)| cell(c)).max().unwrap_or(0);
+    let bits = 64 - top.leading_zeros();
+    if bits == 0 {
+        return keys;
+    }
+    let passes = bits.div_ceil(RADIX_BITS);
+    let width = bits.div_ceil(passes);
+    let buckets = 1usize << width;
+    let mask = (buckets - 1) as u64;
+    let mut other = vec![(0u64, 0u32); keys.len()];
+    for pass in 0..passes {
+        let digit_shift = pass * width;
+        let digit = |c: u64| ((cell(c) >> digit_shift) & mask) as usize;
+        let mut start = vec![0usize; buckets];
+        for &(c, _) in &keys {
+            start[digit(c)] += 1;
+        }
+        let mut acc = 0;
+        for s in start.iter_mut() {
+            (*s, acc) = (acc, acc + *s);
+        }
+        for &item in &keys {
+            let d = digit(item.0);
+            other[start[d]] = item;
+            start[d] += 1;
+        }
+        std::mem::swap(&mut keys, &mut other);
+    }
+    keys
+}
+
+/// Largest digit of [`cell_sorted`]'s radix passes, in bits (4096 buckets of counts: a few
+/// kilobytes, in the L1 cache).
+const RADIX_BITS: u32 = 12;
+
 /// The permutation that sorts `points` along the Morton curve of their bounding box (ties by
 /// index): `order[r]` is the input index of the point at rank `r`.
 pub fn morton_order(points: &[Point3]) -> Vec<u32> {
@@ -230,6 +283,39 @@ mod tests {
         for &i in &order[..8] {
             let p = pts[i as usize];
             assert!(p[0] < 2.0 && p[1] < 2.0 && p[2] < 2.0, "{p:?}");
+        }
+    }
+
+    #[test]
+    fn cell_sort_is_stable_by_cell_key() {
+        // Pseudo-random points, many per cell at the coarser levels.
+        let mut s = 7u64;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let pts: Vec<Point3> = (0..20_000).map(|_| [rnd(), rnd(), rnd()]).collect();
+        let q = Quantizer::new(&pts).unwrap();
+        for level in [0, 5, 13, 17, 20, 21] {
+            let sorted = cell_sorted(&pts, &q, level);
+            let full = morton_sorted(&pts, &q);
+            let key = |c: u64| c >> (3 * level);
+            // The same cells in the same order as the full Morton sort...
+            let cells = |v: &[(u64, u32)]| v.iter().map(|&(c, _)| key(c)).collect::<Vec<_>>();
+            assert_eq!(cells(&sorted), cells(&full), "level {level}");
+            // ...a permutation with the codes of its points, input order within a cell.
+            let mut ids: Vec<u32> = sorted.iter().map(|&(_, i)| i).collect();
+            for w in sorted.windows(2) {
+                assert!(
+                    key(w[0].0) < key(w[1].0) || w[0].1 < w[1].1,
+                    "level {level}"
+                );
+            }
+            assert!(sorted.iter().all(|&(c, i)| c == q.code(&pts[i as usize])));
+            ids.sort_unstable();
+            assert_eq!(ids, (0..pts.len() as u32).collect::<Vec<_>>());
         }
     }
 }

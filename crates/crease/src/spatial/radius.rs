@@ -9,7 +9,7 @@
 use rayon::prelude::*;
 
 use super::grid::{dist2, CellGrid};
-use super::knn::{check_finite, estimate_kth_distance, knn, Neighborhoods};
+use super::knn::{check_finite, knn, kth_distance_subsampled, Neighborhoods};
 use super::morton::{morton_sorted, Quantizer, MORTON_BITS};
 use crate::geometry::{Csr, Point3};
 use crate::{Error, Result};
@@ -53,10 +53,8 @@ pub fn knn_within(points: &[Point3], k: usize, r: f64) -> Result<Neighborhoods> 
     if n > k {
         // When the ball is larger than the typical k-neighbourhood, the kNN search is cheaper.
         if let Some(quant) = Quantizer::new(points) {
-            let sorted = morton_sorted(points, &quant);
-            let rk = estimate_kth_distance(points, &sorted, k);
+            let rk = kth_distance_subsampled(points, &quant, k);
             if r >= rk {
-                drop(sorted);
                 let nb = knn(points, k)?;
                 let lists = nb.into_csr();
                 let r2 = r * r;
