@@ -36,8 +36,12 @@
 //!
 //! Measured on 1M points of a cube's faces at k = 20 (release, 2 threads, best of 3 in one
 //! process, side by side with PCL and Open3D by `scripts/compare-normals.sh`):
-//! `pca_normals_direct` 0.587 s on a Morton-sorted file (PCL `NormalEstimationOMP` 1.65 s,
-//! Open3D 2.12 s) and 0.631 s in random order (PCL 4.01 s, Open3D 11.6 s).
+//! `pca_normals_direct` 0.468 s on a Morton-sorted file (PCL `NormalEstimationOMP` 1.745 s,
+//! Open3D 2.28 s: 3.7x) and 0.662 s in random order (PCL 3.74 s, Open3D 10.2 s: 5.7x), 2026-12-02;
+//! another run that day 0.556 s sorted (PCL 1.78 s, 3.2x), 0.609 s random (PCL 3.99 s, 6.6x).
+//! The covariances are computed in the query loop and parked in the output slots, then solved
+//! four at a time ([`smallest_eigen4`]): the scalar solve is a latency-bound chain of square
+//! roots and divisions.
 
 use rayon::prelude::*;
 use wide::bytemuck::cast;

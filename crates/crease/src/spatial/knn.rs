@@ -44,11 +44,13 @@
 //! The machine's speed varies by ±20 % from minute to minute (a shared host), so figures are
 //! best of several runs, and comparisons were run side by side
 //! (`cargo run --release -p crease --example normals_timing`, `scripts/compare-normals.sh`):
-//! * `pca_normals_direct` ([`knn_map_set`] + PCA) on a Morton-sorted 1M-point file, best of 3
-//!   in one process: 0.587 s (PCL `NormalEstimationOMP` 1.65 s in the same run of
-//!   `scripts/compare-normals.sh`), random input order 0.631 s (PCL 4.01 s); peak memory of
-//!   `crease normals` 126 MB. On an earlier day, slower machine: the shell search 1.17 s, the
-//!   first block search 0.95 s (PCL 2.34 s).
+//! * `pca_normals_direct` ([`knn_map_set_unzip`] + PCA) on a Morton-sorted 1M-point file, best
+//!   of 3 in one process: 0.468 s (PCL `NormalEstimationOMP` 1.745 s in the same run of
+//!   `scripts/compare-normals.sh`, 2026-12-02), random input order 0.662 s (PCL 3.74 s); peak
+//!   memory of `crease normals` 116 MB. The day before: 0.587 s (PCL 1.65 s), before the
+//!   subsampled k-th distance estimate, the radix cell sort ([`cell_sorted`]) and the batched
+//!   eigen solves. On an earlier day, slower machine: the shell search 1.17 s, the first block
+//!   search 0.95 s (PCL 2.34 s).
 //! * Instructions per query (callgrind, 100k points, one thread): the shell search ≈ 7000 for
 //!   kNN alone; the block search 6340 ranked at first, now 4890 ranked ([`knn`], [`knn_map`])
 //!   and 3810 for the unranked set ([`knn_map_set`]). What took the difference, by
