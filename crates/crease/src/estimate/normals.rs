@@ -701,13 +701,9 @@ mod tests {
 
     #[test]
     fn eigen4_is_bitwise_the_scalar_solve() {
-        let mut s = 99u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(99);
+        let mut rnd = || rng.random_range(-0.5..0.5);
         let mut mats: Vec<[f64; 6]> = Vec::new();
         for i in 0..4000 {
             // Covariances of random, flat (plane-like), line-like and degenerate sets.

@@ -289,13 +289,9 @@ mod tests {
     #[test]
     fn cell_sort_is_stable_by_cell_key() {
         // Pseudo-random points, many per cell at the coarser levels.
-        let mut s = 7u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        let mut rnd = || rng.random_range(0.0..1.0);
         let pts: Vec<Point3> = (0..20_000).map(|_| [rnd(), rnd(), rnd()]).collect();
         let q = Quantizer::new(&pts).unwrap();
         for level in [0, 5, 13, 17, 20, 21] {
