@@ -7,9 +7,9 @@ use crease::eval::roc::roc;
 use crease::eval::Confusion;
 use crease::geometry::TriMesh;
 use crease::meshfeat::{
-    add_noise, detect_prepared, dihedral_labels, hysteresis_scores, labels_from_pairs,
-    mean_tangent_angle, potts_labels, read_abc_sharp_edges, tangent_angles, EdgeMesh, EdgeMethod,
-    EdgePairs, EdgeParams, PottsParams, TangentParams,
+    accept_angle, add_noise, detect_prepared, dihedral_labels, hysteresis_scores,
+    labels_from_pairs, mean_tangent_angle, potts_labels, read_abc_sharp_edges, tangent_angles,
+    EdgeMesh, EdgeMethod, EdgePairs, EdgeParams, PottsParams, TangentParams,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -45,6 +45,7 @@ fn tangent_angle_is_exact_on_a_clean_cube_and_per_scale() {
     // the corners.)
     let paper = TangentParams {
         mean_init: false,
+        noise_accept: None,
         ..TangentParams::default()
     };
     let t = tangent_angles(&em, &paper).unwrap();
@@ -210,4 +211,42 @@ fn abc_sharp_curves_are_mesh_edges_and_tangent_angle_separates_them() {
     let n = truth.iter().filter(|&&t| t).count();
     assert_eq!(n, 982);
     assert!(auc(&em.dihedral, &truth) > 0.99);
+}
+
+/// The acceptance angle follows the measured face-normal noise: the paper's 23° on a clean
+/// part, 1.5 × the median adjacent-face angle on a noisy one (clamped to [23°, 85°]), and
+/// always 23° with `noise_accept: None`.
+#[test]
+fn acceptance_angle_follows_the_face_normal_noise() {
+    let (mesh, _) = synth("fillet-chamfer-cone", 30.0);
+    let clean = EdgeMesh::new(&mesh).unwrap();
+    let p = TangentParams::default();
+    let paper = TangentParams {
+        noise_accept: None,
+        ..TangentParams::default()
+    };
+    assert!((accept_angle(&clean, &p).to_degrees() - 23.0).abs() < 1e-9);
+    let noisy_mesh = add_noise(&mesh, 0.01, 5).unwrap();
+    let noisy = EdgeMesh::new(&noisy_mesh).unwrap();
+    let mut d: Vec<f64> = (0..noisy.topo.num_edges())
+        .filter(|&e| noisy.topo.edge_faces(e).len() == 2)
+        .map(|e| noisy.dihedral[e])
+        .collect();
+    d.sort_by(f64::total_cmp);
+    let median = d[d.len() / 2];
+    let a = accept_angle(&noisy, &p);
+    assert!(
+        a.to_degrees() > 23.0 && a.to_degrees() <= 85.0,
+        "{} degrees (median adjacent-face angle {})",
+        a.to_degrees(),
+        median.to_degrees()
+    );
+    assert!((a - 1.5 * median).abs() < 1e-12);
+    assert!((accept_angle(&noisy, &paper).to_degrees() - 23.0).abs() < 1e-9);
+    // A negative factor is refused.
+    let bad = TangentParams {
+        noise_accept: Some(-1.0),
+        ..TangentParams::default()
+    };
+    assert!(tangent_angles(&noisy, &bad).is_err());
 }

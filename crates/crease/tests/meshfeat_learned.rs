@@ -174,6 +174,27 @@ fn svm_separates_blobs_and_its_model_file_round_trips() {
     std::fs::write(&path, "{\"format\": \"x\"}").unwrap();
     let e = SvmModel::read(&path).unwrap_err().to_string();
     assert!(e.contains("m.json"), "{e}");
+    // A version-1 file (before the tangent-plane features recorded their noise-adapted
+    // acceptance angle) reads as the paper's fixed 23 degrees; a newer version is refused.
+    let v1 = model
+        .to_json()
+        .replacen(
+            &format!("\"version\":{}", model.version),
+            "\"version\":1",
+            1,
+        )
+        .replace(",\"tangent_noise_accept\":1.5", "")
+        .replace(",\"tangent_noise_accept\":null", "");
+    assert!(!v1.contains("tangent_noise_accept"), "{}", &v1[..300]);
+    let old = SvmModel::from_json(&v1).unwrap();
+    assert_eq!(old.version, 1);
+    assert_eq!(old.features.params().tangent.noise_accept, None);
+    let newer = model.to_json().replacen(
+        &format!("\"version\":{}", model.version),
+        "\"version\":99",
+        1,
+    );
+    assert!(SvmModel::from_json(&newer).is_err());
     let mut wrong = model.clone();
     wrong.coef.push(1.0);
     assert!(SvmModel::from_json(&wrong.to_json()).is_err());
@@ -187,7 +208,8 @@ fn svm_separates_blobs_and_its_model_file_round_trips() {
 
 /// The shipped model (trained on synthetic parts only) against the tangent-plane angle on
 /// noisy fandisk (section 6.1 protocol: clean dihedral > 25 degrees, 0.5 % noise): measured
-/// with `examples/meshfeat_learned.rs`, AUC 94.9 % against 93.8 %.
+/// with `examples/meshfeat_learned.rs`, AUC 95.0 % against 94.75 % (the tangent-plane angle
+/// with the noise-adapted acceptance angle; 93.8 % with the paper's fixed 23°).
 #[test]
 fn learned_beats_the_tangent_angle_on_noisy_fandisk() {
     let Some(dir) = common::data_dir() else {
@@ -210,7 +232,7 @@ fn learned_beats_the_tangent_angle_on_noisy_fandisk() {
     .unwrap();
     let auc_learned = roc(&learned.sharpness, &truth).unwrap().auc;
     assert!(
-        auc_learned > auc_tangent + 0.005 && auc_learned > 0.94,
+        auc_learned > auc_tangent && auc_learned > 0.945 && auc_tangent > 0.94,
         "learned {auc_learned} tangent {auc_tangent}"
     );
     // The graph cut with the SVM data term (eq. 2): a labelling at least as good as the

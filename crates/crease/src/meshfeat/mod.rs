@@ -43,7 +43,7 @@ pub use baseline::{hysteresis_scores, threshold};
 pub use features::{edge_features, EdgeFeatures, FeatureParams, NUM_FEATURES};
 pub use potts::{potts_labels, potts_labels_unary, svm_unary, EdgePairs, PottsParams};
 pub use svm::{default_model, SvmModel, TrainParams, TrainingSet};
-pub use tangent::{tangent_angles, TangentAngles, TangentParams, PAPER_SCALES};
+pub use tangent::{accept_angle, tangent_angles, TangentAngles, TangentParams, PAPER_SCALES};
 pub use train::{synthetic_meshes, training_set, LabelledMesh, SetParams};
 pub use truth::{add_noise, dihedral_labels, labels_from_pairs, read_abc_sharp_edges};
 
@@ -276,8 +276,8 @@ impl EdgeMethod {
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeParams {
     /// The method (default `learned` with the shipped model: the most accurate on the noisy
-    /// meshes of Table 2, mean AUC 91.7 % against 87.5 % for the tangent-plane angle and
-    /// 89.3 % for `potts-learned`, measured with `examples/meshfeat_learned.rs`).
+    /// meshes of Table 2, mean AUC 92.4 % against 90.1 % for the tangent-plane angle and
+    /// 90.0 % for `potts-learned`, measured with `examples/meshfeat_learned.rs`).
     pub method: EdgeMethod,
     /// Threshold of `dihedral` / `tangent` and high threshold of `hysteresis`, degrees
     /// (default 65: where θ̂ʳ gives the best F1 on the noisy synthetic parts; on clean meshes
@@ -313,7 +313,8 @@ pub const LEARNED_POTTS: PottsParams = PottsParams {
 /// length): the three smallest of section 4. Measured with `examples/meshfeat_table2.rs` on
 /// the 14 noisy meshes: mean AUC 89.2 % (r = 4, 7, 10 %) against 89.3 % for r = 7, 10, 13 %
 /// at 2.3 times the cost and 84.0 % for r = 4 % alone (dihedral thresholding: 78.8 %;
-/// measured before the 2-edge smallest radius, with which the default gives 87.5 %).
+/// measured before the 2-edge smallest radius, with which the default gives 87.5 %, and 90.1 %
+/// with the noise-adapted acceptance angle).
 pub const DEFAULT_TANGENT_SCALES: [f64; 3] = [0.04, 0.07, 0.10];
 
 impl Default for EdgeParams {

@@ -33,8 +33,10 @@ use super::features::{EdgeFeatures, FeatureParams};
 use crate::eval::roc::roc;
 use crate::{Error, Result};
 
-/// Version of the model file format.
-pub const MODEL_VERSION: u32 = 1;
+/// Version of the model file format (2: the features record the tangent-plane estimator's
+/// noise-adapted acceptance angle, `tangent_noise_accept`; version-1 files read as the paper's
+/// fixed angle).
+pub const MODEL_VERSION: u32 = 2;
 /// The `format` tag of a model file.
 pub const MODEL_FORMAT: &str = "crease-edge-svm";
 /// Support vector coordinates are stored as integers of this many units per 1 (they are in
@@ -107,6 +109,11 @@ pub struct FeatureSpec {
     pub tangent_scales: Vec<f64>,
     /// Tangent-plane face budget.
     pub tangent_max_faces: Option<usize>,
+    /// The noise factor of the tangent-plane acceptance angle
+    /// ([`crate::meshfeat::TangentParams::noise_accept`]); absent in version-1 models, which
+    /// were trained with the paper's fixed 23°.
+    #[serde(default)]
+    pub tangent_noise_accept: Option<f64>,
     /// Curvature scales.
     pub curvature_scales: Vec<f64>,
     /// Curvature ball budget.
@@ -119,6 +126,7 @@ impl FeatureSpec {
         FeatureSpec {
             tangent_scales: p.tangent.scales.clone(),
             tangent_max_faces: p.tangent.max_faces,
+            tangent_noise_accept: p.tangent.noise_accept,
             curvature_scales: p.curvature_scales.clone(),
             max_items: p.max_items,
         }
@@ -129,6 +137,7 @@ impl FeatureSpec {
         let mut p = FeatureParams::default();
         p.tangent.scales = self.tangent_scales.clone();
         p.tangent.max_faces = self.tangent_max_faces;
+        p.tangent.noise_accept = self.tangent_noise_accept;
         p.curvature_scales = self.curvature_scales.clone();
         p.max_items = self.max_items;
         p
