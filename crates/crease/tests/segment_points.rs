@@ -256,7 +256,10 @@ fn abc_vertices_as_a_cloud() {
         "ABC vertices as a cloud: {} surfaces, typed {typed:.4}",
         seg.surfaces.len()
     );
-    assert!(typed > 0.95, "typed {typed}");
+    assert!(typed > 0.965, "typed {typed}");
+    // No residual surfaces along the creases: 15 true surfaces, 17 found (24 before crease
+    // bands that their neighbours explain were dissolved, with typed 0.967).
+    assert!(seg.surfaces.len() <= 19, "{} surfaces", seg.surfaces.len());
     // The large surfaces (planes, the cylinder) are recovered with their parameters.
     for (i, t) in truth.surfaces.iter().enumerate() {
         let Some(t) = t else { continue };
