@@ -87,9 +87,9 @@ pub struct SegmentParams {
     /// `th_seed` of the torus, 7) become seeds of any type and grow too, for up to three rounds
     /// (default true). Not in
     /// the paper: small patches whose curvature labels are spoiled by their neighbours (the
-    /// spherical corners between three fillets) get no seed of their own otherwise. A residual
-    /// region along a crease that the surfaces beside it explain to within their own noise is
-    /// dissolved again (see `crease_band`).
+    /// spherical corners between three fillets) get no seed of their own otherwise. (On
+    /// clouds, any grown region along a crease that the surfaces beside it explain to within
+    /// their own noise is dissolved again, residual or not: see `crease_band`.)
     pub residual_seeds: bool,
     /// Angle tolerance (degrees) of the parallel / orthogonal tests of the recognition of
     /// section 6 (default 2); positions are compared within `2 · th_pos` mean edge lengths.
@@ -343,6 +343,7 @@ pub fn segment_mesh(
             bez: &bez,
             weight: &weight,
             no_residual: &forced,
+            dissolve_crease_bands: false,
             diag,
         },
         params,
@@ -404,6 +405,10 @@ pub(crate) struct GraphInput<'a, G: Adjacency> {
     pub weight: &'a [f64],
     /// Vertices that never seed a residual region (on creases).
     pub no_residual: &'a [bool],
+    /// Dissolve the regions of crease bands (`crease_band`): clouds, whose estimated normals
+    /// blend the faces at a crease. Not meshes: a narrow CAD strip (a chamfer one triangle
+    /// wide) may have all its vertices on its border curves, which lie on its neighbours too.
+    pub dissolve_crease_bands: bool,
     /// Bounding-box diagonal.
     pub diag: f64,
 }
@@ -470,6 +475,9 @@ pub(crate) fn segment_graph<G: Adjacency>(
     order.sort_by_key(|&i| std::cmp::Reverse(seeds[i].1.len()));
     let mut owner = vec![-1i32; nv];
     let mut regions: Vec<grow::Region> = Vec::new();
+    // Vertices of regions that the surfaces beside them already explained (`crease_band`):
+    // they seed no residual region.
+    let mut explained = vec![false; nv];
     for i in order {
         let Some((kind, f)) = fitted[i] else { continue };
         let (lab, vs) = &seeds[i];
@@ -483,15 +491,12 @@ pub(crate) fn segment_graph<G: Adjacency>(
             regions.len() as i32,
             &mut owner,
         ) {
-            regions.push(r);
+            add_region(input, r, &mut owner, &mut explained, &mut regions);
         }
     }
     // Residual seeds: connected sets of vertices no region took.
     if params.residual_seeds {
         let min = params.labels.seed_size(label::TORUS);
-        // Vertices of residual regions that the surfaces beside them already explained: they
-        // seed no residual region again.
-        let mut explained = vec![false; nv];
         for _round in 0..3 {
             let mut unowned = vec![label::OTHER; nv];
             for v in 0..nv {
@@ -513,23 +518,7 @@ pub(crate) fn segment_graph<G: Adjacency>(
                 if let Some(r) =
                     grow::grow_seed(&ctx, kind, vs, Some(f), (min, 0.25), id, &mut owner)
                 {
-                    if crease_band(
-                        topo,
-                        input.pos,
-                        &owner,
-                        input.no_residual,
-                        &regions,
-                        &r,
-                        id,
-                        l,
-                    ) {
-                        for &v in &r.vertices {
-                            owner[v as usize] = -1;
-                            explained[v as usize] = true;
-                        }
-                    } else {
-                        regions.push(r);
-                    }
+                    add_region(input, r, &mut owner, &mut explained, &mut regions);
                 }
             }
             if regions.len() == before {
@@ -549,24 +538,60 @@ pub(crate) fn segment_graph<G: Adjacency>(
     }
 }
 
-/// Whether a residual region `r` (id `id`, its vertices marked in `owner`) is a piece of a
-/// crease band that the surfaces beside it already explain: it touches a crease vertex
+/// Appends the grown region `r` (id `regions.len()`, its vertices marked in `owner`) to
+/// `regions`, unless it is a crease band ([`crease_band`], clouds only): then its vertices are
+/// unmarked and flagged `explained` (they seed no residual region).
+fn add_region<G: Adjacency>(
+    input: &GraphInput<G>,
+    r: grow::Region,
+    owner: &mut [i32],
+    explained: &mut [bool],
+    regions: &mut Vec<grow::Region>,
+) {
+    let id = regions.len() as i32;
+    if input.dissolve_crease_bands
+        && crease_band(
+            input.graph,
+            input.pos,
+            owner,
+            input.no_residual,
+            regions,
+            &r,
+            id,
+            input.bez.mean_edge,
+        )
+    {
+        for &v in &r.vertices {
+            owner[v as usize] = -1;
+            explained[v as usize] = true;
+        }
+    } else {
+        regions.push(r);
+    }
+}
+
+/// Whether a grown region `r` (id `id`, its vertices marked in `owner`) is a piece of a
+/// crease band that the surfaces grown before it already explain: it touches a crease vertex
 /// (`crease`: the vertices that seed no residual region), and its vertices lie on the adjacent
 /// surfaces as closely as those surfaces' own points do: the median over its vertices of
 /// min over the adjacent surfaces s of |d_s(v)| / rms_s is at most 3 (a 3-sigma gate; rms_s is
 /// the RMS distance of s's fit, floored at 1e-6 mean edge lengths for exact data).
 ///
-/// Not in the paper (neither are the residual seeds). The vertices no region takes include the
-/// thin bands along creases, whose estimated normals blend the two faces and so fail equation
-/// 5 for both, while their positions lie on the faces. Seeded and fitted on their own, such
-/// bands became small spheres and tori of 10–60 points along the edges (26 of them on a
-/// 1M-point fillet-chamfer-cone cloud with estimated normals, none with exact normals). A true
+/// Not in the paper. Along creases, estimated normals blend the two faces over a thin band
+/// whose positions still lie on the faces: the band's curvature labels seed small cylinders
+/// and cones (a 45° chamfer's band reads as a fillet of one or two edge lengths' radius), and
+/// its vertices, which fail equation 5 for both faces, seed residual spheres and tori of
+/// 10–60 points. Measured on the fillet-chamfer-cone cloud with estimated normals (10 true
+/// surfaces): 17 surfaces at 100k points and 36 at 1M without this test, 10 and 12 with it;
+/// none of them with exact normals. Regions grow in descending seed size, so the faces' large
+/// surfaces exist when a band's region is tested; the vertices of a dissolved region seed no
+/// residual region. A true
 /// small surface is not explained by its neighbours to within their noise: a fillet of radius
 /// r leaves the planes it joins by up to 0.29 r, a spherical corner its three cylinders by up
 /// to 0.18 r. (The position tolerance of equation 4, half an edge length, was tried first as
 /// the gate: it dissolved the rounded cube's fillets of 1–2 edge lengths' radius.) The
-/// vertices of a dissolved region are left to the left-over assignment (clouds) or the face
-/// propagation (meshes), which give them to the nearest compatible neighbour.
+/// vertices of a dissolved region are left to the left-over assignment, which gives them to
+/// the nearest compatible neighbour. Clouds only ([`GraphInput::dissolve_crease_bands`]).
 #[allow(clippy::too_many_arguments)]
 fn crease_band<G: Adjacency>(
     topo: &G,

@@ -321,6 +321,7 @@ fn segment_ordered(
             bez: &bez,
             weight: &weight,
             no_residual: &forced,
+            dissolve_crease_bands: true,
             diag,
         },
         params,
