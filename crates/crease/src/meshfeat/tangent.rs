@@ -52,7 +52,7 @@
 //! (so clean meshes, whose median is a few degrees, are unchanged) and never above 85° (faces
 //! of a perpendicular surface stay out). Measured with `examples/meshfeat_table2.rs` (mean of
 //! the 3 default scales), noisy AUC of θ̂ʳ: mean over the 14 meshes 87.5 % → 90.1 %, the ABC
-//! model 79.9 % → 90.4 %, cylinder 90.4 % → 97.7 %, bar 81.1 % → 86.6 %, sharp_sphere 88.1 % →
+//! model 79.9 % → 90.4 %, cylinder 90.4 % → 97.7 %, bar 81.1 % → 86.3 %, sharp_sphere 88.1 % →
 //! 86.8 % (the one that loses); clean AUCs unchanged. Factors 1 and 2 gave 89.1 % and 89.5 %.
 //!
 //! **Smallest sphere (crease's addition).** r is a fraction of the bounding box's smallest

@@ -585,10 +585,9 @@ fn add_region<G: Adjacency>(
 /// surfaces): 17 surfaces at 100k points and 36 at 1M without this test, 10 and 12 with it;
 /// none of them with exact normals. Regions grow in descending seed size, so the faces' large
 /// surfaces exist when a band's region is tested; the vertices of a dissolved region seed no
-/// residual region. A true
-/// small surface is not explained by its neighbours to within their noise: a fillet of radius
-/// r leaves the planes it joins by up to 0.29 r, a spherical corner its three cylinders by up
-/// to 0.18 r. (The position tolerance of equation 4, half an edge length, was tried first as
+/// residual region. A true small surface is not explained by its neighbours to within their
+/// noise: a fillet of radius r leaves the planes it joins by up to 0.29 r, a spherical corner
+/// its three cylinders by up to 0.18 r. (The position tolerance of equation 4, half an edge length, was tried first as
 /// the gate: it dissolved the rounded cube's fillets of 1–2 edge lengths' radius.) The
 /// vertices of a dissolved region are left to the left-over assignment, which gives them to
 /// the nearest compatible neighbour. Clouds only ([`GraphInput::dissolve_crease_bands`]).
