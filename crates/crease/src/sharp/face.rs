@@ -109,17 +109,22 @@ pub(crate) fn face_normals(points: &[Point3], nbrs: &Neighborhoods) -> Vec<Point
                         continue;
                     }
                     let (p, n) = (points[i], normals[l]);
-                    let wide = nbrs.prefix(i, FACE_K_REFIT);
-                    let on_plane = |q: &&u32| {
-                        let d = vec3::sub(points[**q as usize], p);
-                        vec3::dot(d, n).abs() <= sin_chord * vec3::norm(d)
-                    };
-                    if wide.iter().filter(on_plane).count() < 3 {
+                    // One pass: the neighbours on the plane are counted and summed together
+                    // (the same sums, in the same order, as `plane_covariance`).
+                    let mut mo = Moments::origin();
+                    let mut on = 0usize;
+                    for &j in nbrs.prefix(i, FACE_K_REFIT) {
+                        let d = vec3::sub(points[j as usize], p);
+                        if vec3::dot(d, n).abs() <= sin_chord * vec3::norm(d) {
+                            mo.add(d);
+                            on += 1;
+                        }
+                    }
+                    if on < 3 {
                         done[l] = true;
                         continue;
                     }
-                    let on = wide.iter().filter(on_plane).map(|&j| points[j as usize]);
-                    covs[l] = plane_covariance(p, on);
+                    covs[l] = mo.centroid_covariance().1;
                     refit[l] = true;
                 }
                 if !refit.contains(&true) {

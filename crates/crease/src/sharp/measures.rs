@@ -177,13 +177,7 @@ pub(crate) fn pca_measure_scales(
         for ((o, &(m, c, cov)), (normal, eigenvalues)) in outs.iter_mut().zip(&fits).zip(solved) {
             let rms_radius = (cov[0] + cov[3] + cov[5]).max(0.0).sqrt();
             let offset = vec3::scale(c, -1.0);
-            // The two-sheet test needs the points relative to the centroid.
-            let sheet = two_sheets(
-                coords[1..m]
-                    .iter()
-                    .map(|q| vec3::dot(vec3::sub(*q, p), normal)),
-            );
-            let l = if sheet.is_some() {
+            let l = if own_sheet(&coords[..m], normal).is_some() {
                 local_pca_coords(&coords[..m], weight, work)
             } else {
                 LocalPca {
