@@ -60,8 +60,10 @@ fn run_synth(name: &str, noise: f64) -> (synth::SyntheticMesh, Segmentation, Seg
 /// Every true surface recovered with its type and an IoU of at least `min_iou`; the radius of
 /// its match within `radius_tol` (relative) and the axis within 1°. Surfaces under 1 % of the
 /// part's area (the rounded cube's spherical corners, 19 vertices each) need, with noise, an
-/// IoU of 0.3 and three quarters of them the right type; their radius is not asserted then. Returns
-/// the worst radius error of the surfaces checked.
+/// IoU of 0.3 and three quarters of them the right type; those of the right type get the same
+/// radius tolerance (measured at 1 % noise: 0.2–1.8 %, up to 24 % before the border
+/// refinement of `grow::refine_borders`). Returns the worst radius error of the surfaces
+/// checked.
 fn check_part(name: &str, noise: f64, min_iou: f64, radius_tol: f64) -> f64 {
     let (m, seg, score) = run_synth(name, noise);
     eprintln!(
@@ -100,7 +102,7 @@ fn check_part(name: &str, noise: f64, min_iou: f64, radius_tol: f64) -> f64 {
             mt.truth,
             mt.iou
         );
-        if small {
+        if small && mt.best_type != mt.truth_type {
             continue;
         }
         if let Some(r) = e.radius {
