@@ -288,3 +288,86 @@ fn abc_vertices_as_a_cloud() {
         assert!(best, "true surface {i} ({:?}) not recovered", t.kind());
     }
 }
+
+/// Real depth-sensor scans (`../shared/data/scans`, no labels): the noise-adapted tolerances
+/// (`noise_tolerance`) and the hand-over of explained regions keep them segmented. Measured:
+/// RealSense box 99.2 % of the points assigned (17 % with the paper's tolerances), its two
+/// largest surfaces planes 86° apart; Kinect test0 the table one plane of 79 % of the points
+/// (a 56 % "cone" of half angle 89° before, 64 % assigned); CurvSurf sample: the plane and one
+/// each of the torus, cylinder, sphere and cone of its objects.
+#[test]
+fn real_scans_are_segmented() {
+    use crease::io::{read, ReadOptions};
+    let Some(dir) = common::data_dir() else {
+        return;
+    };
+    let run = |rel: &str| {
+        let (g, _) = read(dir.join(rel), &ReadOptions::default()).unwrap();
+        let seg = segment_points(
+            &g.points.positions,
+            None,
+            &SegmentParams::default(),
+            &PointParams::default(),
+        )
+        .unwrap();
+        let n = seg.point_surface.len();
+        let assigned = seg.point_surface.iter().filter(|&&s| s >= 0).count() as f64 / n as f64;
+        let mut by_size: Vec<&crease::segment::SegmentSurface> = seg.surfaces.iter().collect();
+        by_size.sort_by_key(|s| std::cmp::Reverse(s.vertices));
+        eprintln!(
+            "{rel}: {n} points, {} surfaces, assigned {assigned:.4}, largest {:?}",
+            seg.surfaces.len(),
+            by_size
+                .iter()
+                .take(6)
+                .map(|s| (s.kind, s.vertices))
+                .collect::<Vec<_>>()
+        );
+        (n, assigned, seg)
+    };
+    let normal = |s: &crease::segment::SegmentSurface| match s.params {
+        synth::SurfaceParams::Plane { normal, .. } => normal,
+        _ => panic!("not a plane: {:?}", s.kind),
+    };
+    // RealSense box.
+    let (_, assigned, seg) = run("scans/realsense-box/caixa.ply");
+    assert!(assigned > 0.95, "assigned {assigned}");
+    let mut big: Vec<_> = seg.surfaces.iter().collect();
+    big.sort_by_key(|s| std::cmp::Reverse(s.vertices));
+    let (a, b) = (normal(big[0]), normal(big[1]));
+    let c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).abs();
+    assert!(
+        c < 0.1,
+        "the box's two largest faces are {}° apart",
+        c.acos().to_degrees()
+    );
+    // Kinect: the table is one plane.
+    let (n, assigned, seg) = run("scans/kinect-mosd/test0.pcd");
+    assert!(assigned > 0.95, "assigned {assigned}");
+    let table = seg.surfaces.iter().max_by_key(|s| s.vertices).unwrap();
+    assert_eq!(table.kind, SurfaceType::Plane);
+    assert!(
+        table.vertices as f64 > 0.75 * n as f64,
+        "table {}",
+        table.vertices
+    );
+    // CurvSurf: the objects on the plane.
+    let (n, assigned, seg) = run("scans/curvsurf/sample.xyz");
+    assert!(assigned > 0.95, "assigned {assigned}");
+    let plane = seg.surfaces.iter().max_by_key(|s| s.vertices).unwrap();
+    assert_eq!(plane.kind, SurfaceType::Plane);
+    assert!(plane.vertices as f64 > 0.45 * n as f64);
+    for k in [
+        SurfaceType::Torus,
+        SurfaceType::Cylinder,
+        SurfaceType::Sphere,
+        SurfaceType::Cone,
+    ] {
+        assert!(
+            seg.surfaces
+                .iter()
+                .any(|s| s.kind == k && s.vertices >= 300),
+            "no {k:?} of 300 points"
+        );
+    }
+}

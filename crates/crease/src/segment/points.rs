@@ -322,6 +322,7 @@ fn segment_ordered(
             weight: &weight,
             no_residual: &forced,
             dissolve_crease_bands: true,
+            measure_noise: true,
             diag,
         },
         params,
