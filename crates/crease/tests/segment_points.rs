@@ -26,6 +26,17 @@ fn sample(name: &str, n: usize, noise: f64) -> synth::SyntheticPart {
     .unwrap()
 }
 
+/// Segmentation with estimated normals and the default parameters.
+fn segment_default(points: &[crease::geometry::Point3]) -> PointSegmentation {
+    segment_points(
+        points,
+        None,
+        &SegmentParams::default(),
+        &PointParams::default(),
+    )
+    .unwrap()
+}
+
 fn attr(part: &synth::SyntheticPart, name: &str) -> Vec<i64> {
     part.cloud.attributes.get(name).unwrap().as_i64()
 }
@@ -46,13 +57,7 @@ fn check_part(
     radius_tol: f64,
 ) -> PointSegmentation {
     let part = sample(name, n, noise);
-    let seg = segment_points(
-        &part.cloud.positions,
-        None,
-        &SegmentParams::default(),
-        &PointParams::default(),
-    )
-    .unwrap();
+    let seg = segment_default(&part.cloud.positions);
     let truth: Vec<i32> = attr(&part, synth::attr::SURFACE)
         .iter()
         .map(|&v| v as i32)
@@ -303,13 +308,7 @@ fn real_scans_are_segmented() {
     };
     let run = |rel: &str| {
         let (g, _) = read(dir.join(rel), &ReadOptions::default()).unwrap();
-        let seg = segment_points(
-            &g.points.positions,
-            None,
-            &SegmentParams::default(),
-            &PointParams::default(),
-        )
-        .unwrap();
+        let seg = segment_default(&g.points.positions);
         let n = seg.point_surface.len();
         let assigned = seg.point_surface.iter().filter(|&&s| s >= 0).count() as f64 / n as f64;
         let mut by_size: Vec<&crease::segment::SegmentSurface> = seg.surfaces.iter().collect();

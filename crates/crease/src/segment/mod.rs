@@ -197,6 +197,13 @@ fn type_name<S: serde::Serializer>(t: &SurfaceType, s: S) -> std::result::Result
 /// regions of million-point inputs (a Kinect table of 150k points took 6 s of fits).
 const FIT_SAMPLE: usize = 4096;
 
+/// At most [`FIT_SAMPLE`] of `vs`, evenly strided (all of them when there are fewer), and
+/// whether that is fewer than all.
+fn fit_sample(vs: &[u32]) -> (impl Iterator<Item = u32> + '_, bool) {
+    let step = vs.len().div_ceil(FIT_SAMPLE).max(1);
+    (vs.iter().copied().step_by(step), step > 1)
+}
+
 /// The fit of a seed: the simplest candidate type (plane, sphere, cylinder, cone, torus in
 /// that order) whose RMS error is at most `simpler_factor` times the best candidate's plus
 /// `simpler_floor · l̄`. Candidates: the seed's label type and the simpler types it can
@@ -212,13 +219,13 @@ fn select_model<G: Adjacency>(
 ) -> Option<(SurfaceType, Fit)> {
     use SurfaceType as T;
     // Large seeds are fitted on an even sample (growing refits on the whole region).
-    let step = vs.len().div_ceil(FIT_SAMPLE).max(1);
     let sample: Vec<u32>;
-    let vs = if step > 1 {
-        sample = vs.iter().copied().step_by(step).collect();
-        &sample[..]
-    } else {
-        vs
+    let vs = match fit_sample(vs) {
+        (it, true) => {
+            sample = it.collect();
+            &sample[..]
+        }
+        (_, false) => vs,
     };
     let cands: &[T] = match lab {
         label::PLANE => &[T::Plane],
@@ -261,8 +268,7 @@ fn select_model<G: Adjacency>(
 /// distances to the seed's surface and σ_a = median angle / 1.1774 (Rayleigh) of the angles
 /// between the vertex normals and the surface's normals; the medians ignore the minority of
 /// vertices of seeds that straddle two surfaces. The tolerances become 3 σ_d and 3 σ_a (99.7 %
-/// and 98.9 % of the noise) where those exceed the paper's, capped at 3 l̄ (for the paper's
-/// th_pos) and 30°.
+/// and 98.9 % of the noise) where those exceed the paper's, capped at 3 l̄ and 30°.
 fn noise_tolerance<G: Adjacency>(
     ctx: &grow::Ctx<G>,
     seeds: &[(u8, Vec<u32>)],
@@ -273,11 +279,10 @@ fn noise_tolerance<G: Adjacency>(
         .par_iter()
         .zip(fitted)
         .flat_map_iter(|((_, vs), f)| {
-            let step = vs.len().div_ceil(FIT_SAMPLE).max(1);
             let f = f.map(|(_, f)| f);
-            vs.iter()
-                .step_by(step)
-                .filter_map(move |&v| {
+            fit_sample(vs)
+                .0
+                .filter_map(move |v| {
                     let f = f.as_ref()?;
                     let p = ctx.pos[v as usize];
                     let n = fit::surface_normal(&f.params, p);
@@ -369,8 +374,8 @@ fn reselect<G: Adjacency>(
         T::Cone => &[T::Plane],
         T::Torus => &[T::Plane, T::Sphere, T::Cylinder, T::Cone],
     };
-    let step = r.vertices.len().div_ceil(FIT_SAMPLE).max(1);
-    let sample: Vec<u32> = r.vertices.iter().copied().step_by(step).collect();
+    let (it, sampled) = fit_sample(&r.vertices);
+    let sample: Vec<u32> = it.collect();
     let inl: Vec<u32> = sample
         .iter()
         .copied()
@@ -394,7 +399,7 @@ fn reselect<G: Adjacency>(
         }
         if n as f64 >= 0.9 * inl.len() as f64 && f.rms <= bound {
             r.kind = k;
-            r.fit = if step > 1 {
+            r.fit = if sampled {
                 ctx.fit(k, &r.vertices).unwrap_or(f)
             } else {
                 f
@@ -624,7 +629,7 @@ pub(crate) fn segment_graph<G: Adjacency>(
         let wide = noise_tolerance(&ctx, &seeds, &fitted, l);
         // Only a clear widening refits the seeds (exact and mildly noisy inputs keep the
         // paper's tolerances, and their results, bit for bit).
-        if wide.pos > 1.05 * tol.pos || wide.cos_norm < tol.cos_norm.min(1.0) - 1e-4 {
+        if wide.pos > 1.05 * tol.pos || wide.cos_norm < tol.cos_norm - 1e-4 {
             ctx.tol = grow::Tol {
                 pos: wide.pos.max(tol.pos),
                 cos_norm: wide.cos_norm.min(tol.cos_norm),
@@ -723,7 +728,7 @@ pub(crate) fn segment_graph<G: Adjacency>(
 
 /// Appends the grown region `r` (id `regions.len()`, its vertices marked in `owner`) to
 /// `regions`, unless it is a crease band ([`crease_band`], clouds only): then its vertices are
-/// unmarked and flagged `explained` (they seed no residual region).
+/// handed to its neighbours ([`hand_over`]).
 fn add_region<G: Adjacency>(
     input: &GraphInput<G>,
     ctx: &grow::Ctx<G>,
@@ -783,7 +788,7 @@ fn hand_over<G: Adjacency>(
 /// smaller than a band's seed grows after the band was tested (at 40k points the 45° chamfer
 /// of the fillet-chamfer-cone part, 8 spacings wide, grew after three cylinders of 66–195
 /// points along its borders, radius 1.5 spacings). Dissolved regions are removed, the others
-/// renumbered in order; their vertices are left unowned (for the left-over assignment).
+/// renumbered in order; their vertices are handed to their neighbours ([`hand_over`]).
 fn dissolve_crease_bands<G: Adjacency>(
     input: &GraphInput<G>,
     ctx: &grow::Ctx<G>,
@@ -836,8 +841,10 @@ fn dissolve_crease_bands<G: Adjacency>(
 }
 
 /// Whether a grown region `r` (id `id`, its vertices marked in `owner`) is a piece of a
-/// crease band that the surfaces grown before it already explain: its vertices lie on the
-/// adjacent surfaces as closely as those surfaces' own points do: the third quartile over its
+/// crease band that the larger surfaces beside it already explain, and if so, per vertex of
+/// `r`, the adjacent region that explains it best. Only regions with more vertices than `r`
+/// count (a Kinect table of 150k points was otherwise dissolved into the smaller tilted planes
+/// around it). Its vertices lie on the adjacent surfaces as closely as those surfaces' own points do: the third quartile over its
 /// vertices of min over the adjacent surfaces s of |d_s(v)| / rms_s is at most 3 (a 3-sigma
 /// gate; rms_s is the RMS distance of s's fit, floored at 1e-6 mean edge lengths for exact
 /// data). The third quartile rather than the median: a small true surface whose region leaked
@@ -853,15 +860,14 @@ fn dissolve_crease_bands<G: Adjacency>(
 /// surfaces): 17 surfaces at 100k points and 36 at 1M without this test, 10 and 10 with it;
 /// none of them with exact normals. The test applies to every region, not only to those that
 /// touch a crease vertex (a vertex that seeds no residual region): at 1M points two regions
-/// of 10–12 points between two planes touched none and stayed as a torus and a sphere. Regions grow in descending seed size, so the faces' large
-/// surfaces exist when a band's region is tested (and [`dissolve_crease_bands`] tests every
+/// of 10–12 points between two planes touched none and stayed as a torus and a sphere.
+/// Regions grow in descending seed size, so the faces' large surfaces exist when a band's region is tested (and [`dissolve_crease_bands`] tests every
 /// region again once all have grown); the vertices of a dissolved region seed no
 /// residual region. A true small surface is not explained by its neighbours to within their
 /// noise: a fillet of radius r leaves the planes it joins by up to 0.29 r, a spherical corner
-/// its three cylinders by up to 0.18 r. (The position tolerance of equation 4, half an edge length, was tried first as
-/// the gate: it dissolved the rounded cube's fillets of 1–2 edge lengths' radius.) The
-/// vertices of a dissolved region are left to the left-over assignment, which gives them to
-/// the nearest compatible neighbour. Clouds only ([`GraphInput::dissolve_crease_bands`]).
+/// its three cylinders by up to 0.18 r. (The position tolerance of equation 4, half an edge
+/// length, was tried first as the gate: it dissolved the rounded cube's fillets of 1–2 edge
+/// lengths' radius.) Clouds only ([`GraphInput::dissolve_crease_bands`]).
 fn crease_band<G: Adjacency>(
     topo: &G,
     pos: &[Point3],
