@@ -45,14 +45,21 @@ fn score(points: &[Point3], pred: &[bool], truth: &[bool]) -> (f64, f64, f64) {
 /// two-cylinders 0.931 / 0.917 / 0.919 / 0.910 (0.936 / 0.921 / 0.919 / 0.917), box-hole
 /// 0.936 / 0.929 / 0.920 / 0.924 (0.941 / 0.933 / 0.928 / 0.936), fillet-chamfer-cone 0.917 /
 /// 0.900 / 0.896 / 0.889 (0.916 / 0.904 / 0.903 / 0.893; its chamfer edges turn by 45° only).
+///
+/// With the surface stage (the default), at noise 0 / 5 %: cube 0.920 / 0.924, two-cylinders
+/// 0.917 / 0.920, box-hole 0.922 / 0.908, fillet-chamfer-cone 0.915 / 0.863. Its lines lie on
+/// the edge itself (tolerant precision 0.998–0.999 on the first three parts, against
+/// 0.976–0.986): that costs tolerant recall (0.85 against 0.92 on the cube), because the truth
+/// band reaches two average spacings from the edge and the tolerance is two spacings too, so
+/// truth points at the band's border are matched only by predictions off the edge on their side.
 #[test]
 fn synthetic_parts_projected_distance() {
     let mut table = String::new();
     for (name, min_tol_f1) in [
-        ("cube", 0.93),
+        ("cube", 0.91),
         ("two-cylinders", 0.9),
-        ("box-hole", 0.91),
-        ("fillet-chamfer-cone", 0.87),
+        ("box-hole", 0.89),
+        ("fillet-chamfer-cone", 0.85),
     ] {
         for noise in [0.0, 0.01, 0.03, 0.05] {
             let p = part(name, 20_000, noise);
@@ -192,7 +199,18 @@ fn invariant_to_scale_and_threads() {
         .build()
         .expect("pool")
         .install(|| detect_points(&p.cloud.positions, &params).expect("detect"));
-    assert_eq!(one, a);
+    assert_eq!(
+        (&one.sharp, &one.sharpness, &one.scales),
+        (&a.sharp, &a.sharpness, &a.scales)
+    );
+    let (sa, so) = (
+        a.surfaces.expect("surfaces"),
+        one.surfaces.expect("surfaces"),
+    );
+    assert_eq!(
+        (sa.surfaces, sa.assigned, sa.explained, sa.sigma),
+        (so.surfaces, so.assigned, so.explained, so.sigma)
+    );
 }
 
 /// The scales may be given in any order: the same labels for decreasing as for increasing k.
@@ -261,12 +279,18 @@ fn manual_threshold_and_errors() {
 /// noise-free (ratio 0.000, no regularisation); noisy median 0.231 (0.136 before the
 /// automatic regularisation; 0133 0.410, 6944 0.111, 7010 0.234, 7023 0.383, 7029 0.382, 7031
 /// 0.052, 7034 0.229, 7038 −0.002), every noisy cloud regularised (ratio 0.16–0.22).
+///
+/// With the surface stage (`crease::sharp::surfaces`, the default): clean median 0.812 (0133
+/// 0.840, 6944 0.785, 7010 0.640, 7023 0.957, 7029 0.943, 7031 0.203, 7034 0.885, 7038 0.458),
+/// noisy 0.314 (0133 0.568, 6944 0.375, 7010 0.253, 7023 0.559, 7029 0.498, 7031 0.120, 7034
+/// 0.228, 7038 −0.001). The surfaces decide most points of the noisy models whose segmentation
+/// holds; on the thin plates (7034, 7038) the detector still decides.
 #[test]
 fn pcednet_median_mcc() {
     let Some(dir) = common::data_dir() else {
         return;
     };
-    for (set, min_median) in [("abc", 0.76), ("abc-noisy", 0.21)] {
+    for (set, min_median) in [("abc", 0.80), ("abc-noisy", 0.29)] {
         let mut names: Vec<_> = std::fs::read_dir(dir.join("points-gt").join(set))
             .expect("points-gt folder")
             .filter_map(|e| e.ok().map(|e| e.path()))
@@ -289,6 +313,12 @@ fn pcednet_median_mcc() {
                 r.noise_ratio.unwrap_or(0.0)
             );
             assert_eq!(r.regularized, set == "abc-noisy", "{table}");
+            let s = r
+                .surfaces
+                .as_ref()
+                .expect("the surface stage runs by default");
+            assert!(s.surfaces > 0 && s.explained <= s.assigned, "{table}");
+            assert_eq!(s.sigma > 0.0, set == "abc-noisy", "{table}");
             // The thin-plate model: both edges of its rims kept by the same-side thinning.
             if set == "abc" && path.ends_with("7038.ply") {
                 assert!(c.mcc() >= 0.43, "{table}");

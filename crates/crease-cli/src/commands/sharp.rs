@@ -45,6 +45,12 @@ pub struct SharpArgs {
     /// isolated detections on noisy scans at the price of some thin-line detail.
     #[arg(long)]
     pub regularize: Option<f64>,
+    /// Clouds: skip the surface stage (by default, where the cloud's segmentation into planes,
+    /// cylinders, cones, spheres and tori explains a point's neighbourhood, the point is sharp
+    /// when it lies on the intersection of two of them meeting at an angle; see
+    /// `crease::sharp::surfaces`). Faster, and tran's method as published.
+    #[arg(long)]
+    pub no_surfaces: bool,
     /// Treat a mesh as a point cloud (ignore its faces).
     #[arg(long)]
     pub points_only: bool,
@@ -103,6 +109,9 @@ pub fn run(g: &Global, a: &SharpArgs) -> anyhow::Result<()> {
         density_invariant: !a.raw,
         ..Default::default()
     };
+    if a.no_surfaces {
+        params.surfaces = None;
+    }
     params.otsu.upper_quantile = a.upper_quantile;
     if let Some(lambda) = a.regularize {
         if !(lambda.is_finite() && lambda > 0.0) {
@@ -190,6 +199,9 @@ pub fn run(g: &Global, a: &SharpArgs) -> anyhow::Result<()> {
             "density_invariant": !a.raw,
             "threshold": match a.threshold { Some(t) => serde_json::json!(t), None => "otsu".into() },
             "sharp": num_sharp,
+            "noise_ratio": result.noise_ratio,
+            "regularized": result.regularized,
+            "surfaces": result.surfaces,
             "scales": result.scales,
             "seconds": seconds,
             "timings": {
