@@ -84,8 +84,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let nbrs = crease::spatial::knn(&cloud.positions, kmax)?;
             let r = crease::sharp::detect_points_with(&cloud.positions, &nbrs, &params)?;
             let m = mcc(&r.sharp, &truth);
+            let tp = r.sharp.iter().zip(&truth).filter(|(&p, &t)| p && t).count();
+            let surf = r.surfaces.as_ref().map_or(String::new(), |s| {
+                format!(
+                    " surf={} assigned={:.2} explained={:.2} sigma={:.2}",
+                    s.surfaces,
+                    s.assigned as f64 / truth.len() as f64,
+                    s.explained as f64 / truth.len() as f64,
+                    s.sigma
+                )
+            });
             println!(
-                "{set}/{:<22} n={:>6} gt={:>5} pred={:>6} mcc={m:.3} ({:.2}s) noise={:.3}{} T={:?}",
+                "{set}/{:<22} n={:>6} gt={:>5} pred={:>6} tp={tp:>5} mcc={m:.3} ({:.2}s) noise={:.3}{}{surf} T={:?}",
                 path.file_name().unwrap_or_default().to_string_lossy(),
                 truth.len(),
                 truth.iter().filter(|&&x| x).count(),
