@@ -84,8 +84,8 @@
 //!   than 30° ([`surfaces`]): a fitted surface averages the noise over many points, and a
 //!   tangent junction (fillet) has no such intersection. Measured (median MCC over the 8 ABC
 //!   models, `examples/sharp_pcednet.rs`): clean 0.784 → 0.812 (0133 0.924 → 0.840, 6944 0.684
-//!   → 0.785, 7023 0.947 → 0.957, the others within 0.01), noisy 0.231 → 0.314 (0133 0.410 →
-//!   0.568, 6944 0.111 → 0.375, 7023 0.383 → 0.559, 7029 0.382 → 0.498, 7031 0.052 → 0.120;
+//!   → 0.785, 7023 0.947 → 0.957, the others within 0.01), noisy 0.231 → 0.332 (0133 0.410 →
+//!   0.653, 6944 0.111 → 0.394, 7023 0.383 → 0.593, 7029 0.382 → 0.531, 7031 0.052 → 0.134;
 //!   the thin plates 7034 and 7038, where the segmentation fails, keep the detector's labels).
 //!
 //! **Tried and not kept** (median MCC clean / noisy over the 8 ABC models, or the best MCC a
