@@ -30,7 +30,7 @@
 //! rather than taken from the `levenberg-marquardt` crate, whose API wants a dynamic Jacobian
 //! matrix of all residuals (memory of n × p per iteration) and its own nalgebra version.
 
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector3};
 use rayon::prelude::*;
 
 use crate::geometry::vec3::{add, cross, dot, norm, normalize, scale, sub};
@@ -308,18 +308,10 @@ pub fn cylinder_quadric(pts: &[Point3], w: &[f64]) -> Option<SurfaceParams> {
         atb += row * (z * wi);
     }
     let s = ata.lu().solve(&atb)?;
-    // Hessian [[2a, b], [b, 2c]]: the eigenvector of the eigenvalue of least magnitude.
-    let (a, b, cc) = (2.0 * s[0], s[1], 2.0 * s[2]);
-    let mean = 0.5 * (a + cc);
-    let diff = (0.25 * (a - cc) * (a - cc) + b * b).sqrt();
-    let (l1, l2) = (mean + diff, mean - diff);
-    let lmin = if l1.abs() < l2.abs() { l1 } else { l2 };
-    // (H − λ I) e = 0: e = (b, λ − a) or (λ − c, b), whichever is better conditioned.
-    let e = if (lmin - a).abs() + b.abs() >= (lmin - cc).abs() + b.abs() {
-        [b, lmin - a]
-    } else {
-        [lmin - cc, b]
-    };
+    // The Hessian's eigenvector of the eigenvalue of least magnitude.
+    let h = Matrix2::new(2.0 * s[0], s[1], s[1], 2.0 * s[2]).symmetric_eigen();
+    let i = usize::from(h.eigenvalues[1].abs() < h.eigenvalues[0].abs());
+    let e = h.eigenvectors.column(i);
     let d = normalize(add(scale(u, e[0]), scale(v, e[1])))?;
     cylinder_with_axis(pts, w, d)
 }

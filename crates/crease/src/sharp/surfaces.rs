@@ -45,8 +45,9 @@
 //! F1 0.816 at 0.25, 0.925 at 0.5), hence the gap filling up to twice the width (0.920, and
 //! median 0.812 on PCEDNet). A band one spacing wide or more has no gaps to fill: on the noisy
 //! clouds, whose bands are widened by σ (next paragraph), filling cost 0.02–0.09 MCC on every
-//! model explained (0133 0.653 without, 0.568 with; median 0.332 against 0.317). Thinning the band to the nearest point across the line instead
-//! lost 0.05 on the PCEDNet model 6944, whose ground truth is two points wide. With noise the
+//! model explained (0133 0.653 without, 0.568 with; median 0.332 against 0.317). Thinning the
+//! band to the nearest point across the line instead lost 0.05 on the PCEDNet model 6944,
+//! whose ground truth is two points wide. With noise the
 //! distance to the other surface has an error of up to σ, hence + σ (the best bands measured on
 //! the noisy models were 0.65–0.85 spacings for σ = 0.48–0.80).
 //!
