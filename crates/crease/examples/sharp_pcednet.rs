@@ -87,10 +87,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let tp = r.sharp.iter().zip(&truth).filter(|(&p, &t)| p && t).count();
             let surf = r.surfaces.as_ref().map_or(String::new(), |s| {
                 format!(
-                    " surf={} assigned={:.2} explained={:.2} sigma={:.2}",
+                    " surf={} assigned={:.2} explained={:.2} rim={:.2} sigma={:.2}",
                     s.surfaces,
                     s.assigned as f64 / truth.len() as f64,
                     s.explained as f64 / truth.len() as f64,
+                    s.rim as f64 / truth.len() as f64,
                     s.sigma
                 )
             });

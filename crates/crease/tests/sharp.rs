@@ -284,13 +284,15 @@ fn manual_threshold_and_errors() {
 /// 0.840, 6944 0.785, 7010 0.640, 7023 0.957, 7029 0.943, 7031 0.203, 7034 0.885, 7038 0.458),
 /// noisy 0.314 (0133 0.568, 6944 0.375, 7010 0.253, 7023 0.559, 7029 0.498, 7031 0.120, 7034
 /// 0.228, 7038 −0.001). The surfaces decide most points of the noisy models whose segmentation
-/// holds; on the thin plates (7034, 7038) the detector still decides.
+/// holds. With the rim distance of thin sheets (`sharp/rim.rs`) on the noisy clouds: noisy
+/// median 0.462 (0133 0.656, 6944 0.377, 7010 0.289, 7023 0.631, 7029 0.527, 7031 0.135, 7034
+/// 0.562, 7038 0.396), clean unchanged.
 #[test]
 fn pcednet_median_mcc() {
     let Some(dir) = common::data_dir() else {
         return;
     };
-    for (set, min_median) in [("abc", 0.80), ("abc-noisy", 0.29)] {
+    for (set, min_median) in [("abc", 0.80), ("abc-noisy", 0.44)] {
         let mut names: Vec<_> = std::fs::read_dir(dir.join("points-gt").join(set))
             .expect("points-gt folder")
             .filter_map(|e| e.ok().map(|e| e.path()))
@@ -322,6 +324,15 @@ fn pcednet_median_mcc() {
             // The thin-plate model: both edges of its rims kept by the same-side thinning.
             if set == "abc" && path.ends_with("7038.ply") {
                 assert!(c.mcc() >= 0.43, "{table}");
+            }
+            // The rim distance decides only on noisy clouds; on the noisy thin plates it finds
+            // the rims the segmentation and the projected distance miss.
+            assert_eq!(s.rim > 0, set == "abc-noisy", "{table}");
+            if set == "abc-noisy" && path.ends_with("7034.ply") {
+                assert!(c.mcc() >= 0.50, "{table}");
+            }
+            if set == "abc-noisy" && path.ends_with("7038.ply") {
+                assert!(c.mcc() >= 0.35, "{table}");
             }
             mccs.push(c.mcc());
         }
