@@ -28,7 +28,7 @@ use crease::meshfeat::{
     add_noise, default_model, dihedral_labels, edge_features, labels_from_pairs,
     mean_tangent_angle, potts_labels_unary, read_abc_sharp_edges, svm_unary, sweep_auc,
     tangent_angles, EdgeFeatures, EdgeMesh, EdgePairs, EdgeParams, SvmModel, TrainParams,
-    TrainingSet,
+    TrainingSet, CLASSIC_LABELS,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -38,7 +38,7 @@ struct Opts {
     max_edges: usize,
     grid: bool,
     model: Option<PathBuf>,
-    label_degrees: f64,
+    label_degrees: Option<f64>,
     loo: bool,
     synth_per_side: f64,
 }
@@ -50,7 +50,7 @@ fn parse() -> Opts {
         max_edges: 400,
         grid: false,
         model: None,
-        label_degrees: 25.0,
+        label_degrees: None,
         loo: true,
         synth_per_side: 60.0,
     };
@@ -64,7 +64,7 @@ fn parse() -> Opts {
             "--max-edges" => o.max_edges = v.parse().expect("count"),
             "--grid" => o.grid = v == "1",
             "--model" => o.model = Some(PathBuf::from(v)),
-            "--label-degrees" => o.label_degrees = v.parse().expect("number"),
+            "--label-degrees" => o.label_degrees = Some(v.parse().expect("number")),
             "--loo" => o.loo = v == "1",
             "--synth-per-side" => o.synth_per_side = v.parse().expect("number"),
             a => panic!("unknown option {a}"),
@@ -119,7 +119,19 @@ fn cases(o: &Opts) -> Vec<Case> {
             .expect("mesh file");
         let mesh = g.into_mesh().expect("faces");
         let em = EdgeMesh::new(&mesh).expect("topology");
-        let truth = dihedral_labels(&em, o.label_degrees);
+        // Section 6.1 labels: the mesh's own threshold (`CLASSIC_LABELS`) unless one is given
+        // for all; meshes without feature lines are not scored.
+        let degrees = o.label_degrees.or_else(|| {
+            CLASSIC_LABELS
+                .iter()
+                .find(|c| c.0 == file)
+                .and_then(|c| c.1)
+        });
+        let Some(degrees) = degrees else {
+            println!("{file}: no feature lines (section 6.1, checked by eye), not scored");
+            continue;
+        };
+        let truth = dihedral_labels(&em, degrees);
         drop(em);
         out.push(Case {
             name: file.trim_end_matches(".off").to_string(),

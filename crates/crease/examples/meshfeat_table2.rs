@@ -10,7 +10,8 @@
 //!
 //! Ground truth: synthetic parts exact (`crease::synth::mesh`), the ABC model's sharp curves,
 //! and for the classic meshes of `../shared/data/meshes` the clean mesh's edges whose dihedral
-//! angle exceeds `--label-degrees` (default 25). The Potts columns trace their ROC by sweeping
+//! angle exceeds the mesh's threshold in `crease::meshfeat::CLASSIC_LABELS` (meshes without feature
+//! lines are not scored), or `--label-degrees D` for every mesh (25 until 2026-12-03). The Potts columns trace their ROC by sweeping
 //! θ_true over [0, π] (`--samples`, default 200, as the paper), the others by their score.
 //! Also printed per method: F1 and false-positive rate at the default operating point.
 
@@ -25,7 +26,7 @@ use crease::geometry::TriMesh;
 use crease::meshfeat::{
     add_noise, dihedral_labels, hysteresis_scores, labels_from_pairs, mean_tangent_angle,
     potts_labels, read_abc_sharp_edges, sweep_auc, tangent_angles, threshold, EdgeMesh, EdgePairs,
-    EdgeParams, PottsParams, TangentParams,
+    EdgeParams, PottsParams, TangentParams, CLASSIC_LABELS,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -34,7 +35,7 @@ struct Opts {
     only: Option<String>,
     potts: PottsParams,
     scales: Vec<f64>,
-    label_degrees: f64,
+    label_degrees: Option<f64>,
     noise: f64,
     mean_init: bool,
     iterations: usize,
@@ -49,7 +50,7 @@ fn parse() -> Opts {
         only: None,
         potts: d.potts,
         scales: d.tangent.scales.clone(),
-        label_degrees: 25.0,
+        label_degrees: None,
         noise: 0.005,
         mean_init: d.tangent.mean_init,
         iterations: d.tangent.iterations,
@@ -73,7 +74,7 @@ fn parse() -> Opts {
             "--lambda" => o.potts.lambda = f(),
             "--sigma" => o.potts.sigma = f(),
             "--theta-true" => o.potts.theta_true = f().to_radians(),
-            "--label-degrees" => o.label_degrees = f(),
+            "--label-degrees" => o.label_degrees = Some(f()),
             "--noise" => o.noise = f(),
             "--best" => o.best = v == "1",
             "--mean-init" => o.mean_init = v == "1",
@@ -136,7 +137,19 @@ fn cases(o: &Opts) -> Vec<Case> {
         let (g, _) = crease::io::read(&path, &Default::default()).expect("mesh file");
         let mesh = g.into_mesh().expect("faces");
         let em = EdgeMesh::new(&mesh).expect("topology");
-        let truth = dihedral_labels(&em, o.label_degrees);
+        // Section 6.1 labels: the mesh's own threshold (`CLASSIC_LABELS`) unless one is given
+        // for all; meshes without feature lines are not scored.
+        let degrees = o.label_degrees.or_else(|| {
+            CLASSIC_LABELS
+                .iter()
+                .find(|c| c.0 == file)
+                .and_then(|c| c.1)
+        });
+        let Some(degrees) = degrees else {
+            println!("{file}: no feature lines (section 6.1, checked by eye), not scored");
+            continue;
+        };
+        let truth = dihedral_labels(&em, degrees);
         drop(em);
         out.push(Case {
             name: file.trim_end_matches(".off").to_string(),

@@ -11,7 +11,7 @@ use crease::meshfeat::svm::{train, TrainingSet};
 use crease::meshfeat::{
     add_noise, default_model, detect_prepared, dihedral_labels, edge_features, labels_from_pairs,
     mean_tangent_angle, tangent_angles, EdgeFeatures, EdgeMesh, EdgeMethod, EdgeParams,
-    FeatureParams, SvmModel, TrainParams, NUM_FEATURES,
+    FeatureParams, SvmModel, TrainParams, CLASSIC_LABELS, NUM_FEATURES,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -207,17 +207,24 @@ fn svm_separates_blobs_and_its_model_file_round_trips() {
 }
 
 /// The shipped model (trained on synthetic parts only) against the tangent-plane angle on
-/// noisy fandisk (section 6.1 protocol: clean dihedral > 25 degrees, 0.5 % noise): measured
-/// with `examples/meshfeat_learned.rs`, AUC 95.0 % against 94.75 % (the tangent-plane angle
-/// with the noise-adapted acceptance angle; 93.8 % with the paper's fixed 23°).
+/// noisy fandisk (section 6.1 protocol: clean dihedral above fandisk's 17.5° of
+/// `CLASSIC_LABELS`, 0.5 % noise): measured with `examples/meshfeat_learned.rs`, AUC 93.81 %
+/// against 93.89 % (with the old 25° labels, which left out 56 edges of the shallow creases:
+/// 95.0 % against 94.75 %). The two rank fandisk's edges alike; the learned model is ahead on
+/// the mean of the noisy meshes (95.07 % against 93.48 %).
 #[test]
-fn learned_beats_the_tangent_angle_on_noisy_fandisk() {
+fn learned_matches_the_tangent_angle_on_noisy_fandisk() {
     let Some(dir) = common::data_dir() else {
         return;
     };
     let (g, _) = crease::io::read(dir.join("meshes/fandisk.off"), &Default::default()).unwrap();
     let mesh = g.into_mesh().unwrap();
-    let truth = dihedral_labels(&EdgeMesh::new(&mesh).unwrap(), 25.0);
+    let degrees = CLASSIC_LABELS
+        .iter()
+        .find(|c| c.0 == "fandisk.off")
+        .and_then(|c| c.1)
+        .unwrap();
+    let truth = dihedral_labels(&EdgeMesh::new(&mesh).unwrap(), degrees);
     let noisy = add_noise(&mesh, 0.005, 7).unwrap();
     let em = EdgeMesh::new(&noisy).unwrap();
     let tan = mean_tangent_angle(&tangent_angles(&em, &EdgeParams::default().tangent).unwrap());
@@ -232,7 +239,7 @@ fn learned_beats_the_tangent_angle_on_noisy_fandisk() {
     .unwrap();
     let auc_learned = roc(&learned.sharpness, &truth).unwrap().auc;
     assert!(
-        auc_learned > auc_tangent && auc_learned > 0.945 && auc_tangent > 0.94,
+        auc_learned > auc_tangent - 0.005 && auc_learned > 0.93 && auc_tangent > 0.93,
         "learned {auc_learned} tangent {auc_tangent}"
     );
     // The graph cut with the SVM data term (eq. 2): a labelling at least as good as the

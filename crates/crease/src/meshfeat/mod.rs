@@ -45,7 +45,9 @@ pub use potts::{potts_labels, potts_labels_unary, svm_unary, EdgePairs, PottsPar
 pub use svm::{default_model, SvmModel, TrainParams, TrainingSet};
 pub use tangent::{accept_angle, tangent_angles, TangentAngles, TangentParams, PAPER_SCALES};
 pub use train::{synthetic_meshes, training_set, LabelledMesh, SetParams};
-pub use truth::{add_noise, dihedral_labels, labels_from_pairs, read_abc_sharp_edges};
+pub use truth::{
+    add_noise, dihedral_labels, labels_from_pairs, read_abc_sharp_edges, CLASSIC_LABELS,
+};
 
 use crate::eval::roc::{trapezoid_area, RocPoint};
 use crate::geometry::{chain_segments, vec3, Aabb, MeshTopology, Point3, TriMesh};
