@@ -2,7 +2,10 @@
 //! (median Matthews correlation coefficient of the sharp class, as the benchmark reports it).
 //!
 //! `cargo run --release -p crease --example sharp_pcednet -- [MEASURE] [raw] [nothin] [q=0.99]
-//! [scales=12,16,..] [reg=K,LAMBDA,ALPHA,SLOPE] [noauto] [sets=abc,abc-noisy,default]`
+//! [scales=12,16,..] [reg=K,LAMBDA,ALPHA,SLOPE] [noauto] [auto=RATIO] [sets=abc,abc-noisy,default]`
+//!
+//! `auto=RATIO`: the noise ratio above which the noisy path (Potts labelling, noise-widened
+//! surface bands, rim distance) runs; `auto=-1` forces it (default 0.08).
 
 use std::path::PathBuf;
 
@@ -39,6 +42,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             params.pca_weight = crease::estimate::PcaWeight::Uniform;
         } else if a == "nothin" {
             params.thin = false;
+        } else if let Some(t) = a.strip_prefix("auto=") {
+            params.auto_regularize = Some(t.parse()?);
         } else if a == "noauto" {
             params.auto_regularize = None;
         } else if a == "raw" {
