@@ -25,10 +25,10 @@ use crease::eval::roc::{roc, Roc};
 use crease::geometry::TriMesh;
 use crease::meshfeat::svm::train;
 use crease::meshfeat::{
-    add_noise, default_model, dihedral_labels, edge_features, labels_from_pairs,
-    mean_tangent_angle, potts_labels_unary, read_abc_sharp_edges, svm_unary, sweep_auc,
-    tangent_angles, EdgeFeatures, EdgeMesh, EdgePairs, EdgeParams, SvmModel, TrainParams,
-    TrainingSet, CLASSIC_LABELS,
+    add_noise, classic_label_degrees, default_model, dihedral_labels, edge_features,
+    labels_from_pairs, mean_tangent_angle, potts_labels_unary, read_abc_sharp_edges, svm_unary,
+    sweep_auc, tangent_angles, EdgeFeatures, EdgeMesh, EdgePairs, EdgeParams, SvmModel,
+    TrainParams, TrainingSet,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -121,12 +121,7 @@ fn cases(o: &Opts) -> Vec<Case> {
         let em = EdgeMesh::new(&mesh).expect("topology");
         // Section 6.1 labels: the mesh's own threshold (`CLASSIC_LABELS`) unless one is given
         // for all; meshes without feature lines are not scored.
-        let degrees = o.label_degrees.or_else(|| {
-            CLASSIC_LABELS
-                .iter()
-                .find(|c| c.0 == file)
-                .and_then(|c| c.1)
-        });
+        let degrees = o.label_degrees.or_else(|| classic_label_degrees(file));
         let Some(degrees) = degrees else {
             println!("{file}: no feature lines (section 6.1, checked by eye), not scored");
             continue;

@@ -24,9 +24,9 @@ use crease::eval::roc::roc;
 use crease::eval::Confusion;
 use crease::geometry::TriMesh;
 use crease::meshfeat::{
-    add_noise, dihedral_labels, hysteresis_scores, labels_from_pairs, mean_tangent_angle,
-    potts_labels, read_abc_sharp_edges, sweep_auc, tangent_angles, threshold, EdgeMesh, EdgePairs,
-    EdgeParams, PottsParams, TangentParams, CLASSIC_LABELS,
+    add_noise, classic_label_degrees, dihedral_labels, hysteresis_scores, labels_from_pairs,
+    mean_tangent_angle, potts_labels, read_abc_sharp_edges, sweep_auc, tangent_angles, threshold,
+    EdgeMesh, EdgePairs, EdgeParams, PottsParams, TangentParams,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -139,12 +139,7 @@ fn cases(o: &Opts) -> Vec<Case> {
         let em = EdgeMesh::new(&mesh).expect("topology");
         // Section 6.1 labels: the mesh's own threshold (`CLASSIC_LABELS`) unless one is given
         // for all; meshes without feature lines are not scored.
-        let degrees = o.label_degrees.or_else(|| {
-            CLASSIC_LABELS
-                .iter()
-                .find(|c| c.0 == file)
-                .and_then(|c| c.1)
-        });
+        let degrees = o.label_degrees.or_else(|| classic_label_degrees(file));
         let Some(degrees) = degrees else {
             println!("{file}: no feature lines (section 6.1, checked by eye), not scored");
             continue;

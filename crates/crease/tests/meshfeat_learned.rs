@@ -9,9 +9,9 @@ use crease::geometry::TriMesh;
 use crease::meshfeat::features::{CURVATURE_OFFSET, TANGENT_OFFSET};
 use crease::meshfeat::svm::{train, TrainingSet};
 use crease::meshfeat::{
-    add_noise, default_model, detect_prepared, dihedral_labels, edge_features, labels_from_pairs,
-    mean_tangent_angle, tangent_angles, EdgeFeatures, EdgeMesh, EdgeMethod, EdgeParams,
-    FeatureParams, SvmModel, TrainParams, CLASSIC_LABELS, NUM_FEATURES,
+    add_noise, classic_label_degrees, default_model, detect_prepared, dihedral_labels,
+    edge_features, labels_from_pairs, mean_tangent_angle, tangent_angles, EdgeFeatures, EdgeMesh,
+    EdgeMethod, EdgeParams, FeatureParams, SvmModel, TrainParams, NUM_FEATURES,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -219,11 +219,7 @@ fn learned_matches_the_tangent_angle_on_noisy_fandisk() {
     };
     let (g, _) = crease::io::read(dir.join("meshes/fandisk.off"), &Default::default()).unwrap();
     let mesh = g.into_mesh().unwrap();
-    let degrees = CLASSIC_LABELS
-        .iter()
-        .find(|c| c.0 == "fandisk.off")
-        .and_then(|c| c.1)
-        .unwrap();
+    let degrees = classic_label_degrees("fandisk.off").unwrap();
     let truth = dihedral_labels(&EdgeMesh::new(&mesh).unwrap(), degrees);
     let noisy = add_noise(&mesh, 0.005, 7).unwrap();
     let em = EdgeMesh::new(&noisy).unwrap();

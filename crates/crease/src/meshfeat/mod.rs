@@ -46,7 +46,8 @@ pub use svm::{default_model, SvmModel, TrainParams, TrainingSet};
 pub use tangent::{accept_angle, tangent_angles, TangentAngles, TangentParams, PAPER_SCALES};
 pub use train::{synthetic_meshes, training_set, LabelledMesh, SetParams};
 pub use truth::{
-    add_noise, dihedral_labels, labels_from_pairs, read_abc_sharp_edges, CLASSIC_LABELS,
+    add_noise, classic_label_degrees, dihedral_labels, labels_from_pairs, read_abc_sharp_edges,
+    CLASSIC_LABELS,
 };
 
 use crate::eval::roc::{trapezoid_area, RocPoint};

@@ -98,6 +98,15 @@ pub const CLASSIC_LABELS: [(&str, Option<f64>); 9] = [
     ("torus.off", None),
 ];
 
+/// The [`CLASSIC_LABELS`] threshold of a classic mesh by file name (`"fandisk.off"`); `None` for
+/// the meshes without feature lines and for names not in the table.
+pub fn classic_label_degrees(file: &str) -> Option<f64> {
+    CLASSIC_LABELS
+        .iter()
+        .find(|c| c.0 == file)
+        .and_then(|c| c.1)
+}
+
 /// The sharp feature edges of an ABC model: for every curve of the features YAML with
 /// `sharp: true`, the vertex pairs between consecutive `vert_indices` (0-based into the OBJ's
 /// `v` list).
