@@ -91,7 +91,9 @@
 //!   sheet's rim ([`rim`], from the in-plane offset of the centroid of 80 neighbours, see
 //!   [`surfaces`] step 6): noisy median 0.332 → 0.462 (7034 0.228 → 0.562, 7038 −0.002 →
 //!   0.396, 7023 0.593 → 0.631, 7010 0.271 → 0.289, 6944 0.394 → 0.377, 7029 0.531 → 0.527,
-//!   0133 0.653 → 0.656, 7031 0.134 → 0.135); clean unchanged (0.812).
+//!   0133 0.653 → 0.656, 7031 0.134 → 0.135); clean unchanged (0.812). With the segmentation's
+//!   noise measured on its largest seeds ([`crate::segment`]): noisy 0.464 (0133 0.662, 6944
+//!   0.370, 7010 0.289, 7023 0.646, 7029 0.531, 7031 0.129, 7034 0.562, 7038 0.396).
 //!
 //! **Tried and not kept** (median MCC clean / noisy over the 8 ABC models, or the best MCC a
 //! single threshold on the score reaches, "best"):
