@@ -274,13 +274,10 @@ pub fn refine(
             let (e, dir) = edge[i]?;
             let core = (params.edge_band + sigma) * h[i];
             let wide = (2.0 * params.edge_band + sigma) * h[i];
-            if e < core {
-                return Some((true, if e > 0.0 { (core / e).min(1e6) } else { 1e6 }));
-            }
-            if e >= wide || !fill {
-                // Beyond the bands (no pair of surfaces meeting at an angle: e is infinite and the
-                // sharpness 0).
-                return Some((false, core / e));
+            if e < core || e >= wide || !fill {
+                // In the core band, or beyond the bands (no pair of surfaces meeting at an
+                // angle: e is infinite and the sharpness 0).
+                return Some(band_decision(core, e));
             }
             // Between the core band and twice its width: sharp where the core band of the
             // point's own surface leaves a gap along the line (no core point of the same
@@ -321,25 +318,18 @@ pub fn refine(
             .map(|i| {
                 let row = nbrs.prefix(i, k);
                 let unassigned = row.iter().filter(|&&j| owner[j as usize] < 0).count();
+                let segmented = owner[i] >= 0 && 2 * unassigned <= row.len();
                 let no_pair = edge[i].is_some_and(|(e, _)| e.is_infinite());
-                if owner[i] >= 0 && 2 * unassigned <= row.len() && !no_pair {
+                if segmented && !no_pair {
                     return None;
                 }
                 let (s, rms) = super::rim::rim_distance(points, &index, i, params.rim_k)?;
                 // A point the segmentation explains is a rim point only where its neighbourhood
                 // is one flat sheet within the noise.
-                if owner[i] >= 0
-                    && 2 * unassigned <= row.len()
-                    && rms > params.rim_flatness * sigma * h[i]
-                {
+                if segmented && rms > params.rim_flatness * sigma * h[i] {
                     return None;
                 }
-                let band = (params.rim_band + sigma) * h[i];
-                Some(if s < band {
-                    (true, if s > 0.0 { (band / s).min(1e6) } else { 1e6 })
-                } else {
-                    (false, band / s)
-                })
+                Some(band_decision((params.rim_band + sigma) * h[i], s))
             })
             .collect();
         for (i, d) in rim_decided.into_iter().enumerate() {
@@ -361,6 +351,23 @@ pub fn refine(
         sigma,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// Sharp when `distance` < `band`; the sharpness band / distance (≥ 1 exactly for sharp points,
+/// capped at 1e6, 0 for an infinite distance).
+fn band_decision(band: f64, distance: f64) -> (bool, f64) {
+    if distance < band {
+        (
+            true,
+            if distance > 0.0 {
+                (band / distance).min(1e6)
+            } else {
+                1e6
+            },
+        )
+    } else {
+        (false, band / distance)
+    }
 }
 
 #[cfg(test)]
