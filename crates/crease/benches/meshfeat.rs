@@ -1,8 +1,9 @@
-//! Mesh feature-edge benchmarks (vidal et al. 2011): the learned pipeline (the 43 features of
-//! section 4, then the shipped SVM's decision values) and the default tangent-plane method,
+//! Mesh feature-edge benchmarks (vidal et al. 2011): the default `filtered` method (bilateral
+//! normal filtering, then the dihedral angle), the learned pipeline (the 43 features of
+//! section 4, then the shipped SVM's decision values) and the tangent-plane method,
 //! on the synthetic fillet-chamfer-cone part meshed with about 10k and 100k edges, with
 //! Gaussian noise of 0.5 % of the bounding box (section 6.1). The 1M-edge figure is measured
-//! with `crease edges --method learned` (see the README).
+//! with `crease edges` (see the README).
 //!
 //! Run with `cargo bench -p crease --bench meshfeat`.
 
@@ -28,7 +29,11 @@ fn pipelines(c: &mut Criterion) {
         .expect("mesh");
         let noisy = add_noise(&m.mesh, 0.005, 1).expect("noise");
         let em = EdgeMesh::new(&noisy).expect("topology");
-        for method in [EdgeMethod::Learned, EdgeMethod::Tangent] {
+        for method in [
+            EdgeMethod::Filtered,
+            EdgeMethod::Learned,
+            EdgeMethod::Tangent,
+        ] {
             let p = EdgeParams {
                 method,
                 ..EdgeParams::default()

@@ -24,9 +24,9 @@ use crease::eval::roc::roc;
 use crease::eval::Confusion;
 use crease::geometry::TriMesh;
 use crease::meshfeat::{
-    add_noise, classic_label_degrees, dihedral_labels, hysteresis_scores, labels_from_pairs,
-    mean_tangent_angle, potts_labels, read_abc_sharp_edges, sweep_auc, tangent_angles, threshold,
-    EdgeMesh, EdgePairs, EdgeParams, PottsParams, TangentParams,
+    add_noise, classic_label_degrees, dihedral_labels, filtered_dihedral, hysteresis_scores,
+    labels_from_pairs, mean_tangent_angle, potts_labels, read_abc_sharp_edges, sweep_auc,
+    tangent_angles, threshold, EdgeMesh, EdgePairs, EdgeParams, PottsParams, TangentParams,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -177,11 +177,14 @@ fn cases(o: &Opts) -> Vec<Case> {
 
 /// Scores of one mesh: per method, AUC and the labels at the default operating point.
 struct Row {
-    auc: [f64; 5],
-    conf: [Confusion; 5],
+    auc: [f64; NM],
+    conf: [Confusion; NM],
 }
 
-const METHODS: [&str; 5] = ["thres.", "hys.", "tangent", "dih+G", "tan+G"];
+const NM: usize = 7;
+const METHODS: [&str; NM] = [
+    "thres.", "hys.", "tangent", "dih+G", "tan+G", "filtered", "filt+G",
+];
 
 fn score(o: &Opts, mesh: &TriMesh, truth: &[bool], times: &mut [f64; 2]) -> Row {
     let em = EdgeMesh::new(mesh).expect("topology");
@@ -198,12 +201,18 @@ fn score(o: &Opts, mesh: &TriMesh, truth: &[bool], times: &mut [f64; 2]) -> Row 
     )
     .expect("tangent");
     let tan = mean_tangent_angle(&ta);
+    let filt = filtered_dihedral(&em, d.filter_iterations, &d.bilateral);
+    let tf = d.filtered_degrees.to_radians();
     let hys = hysteresis_scores(&em, &em.dihedral, d.low_ratio).expect("hysteresis");
     let t = d.threshold_degrees.to_radians();
     let auc_of = |s: &[f64]| roc(s, truth).map(|r| r.auc).unwrap_or(f64::NAN);
     let conf = |l: &[bool]| Confusion::from_labels(l, truth).expect("lengths");
     if o.best {
-        for (name, sc) in [("dihedral", &em.dihedral), ("tangent", &tan)] {
+        for (name, sc) in [
+            ("dihedral", &em.dihedral),
+            ("tangent", &tan),
+            ("filtered", &filt),
+        ] {
             let mut best = (0.0, 0.0);
             for deg in 1..90 {
                 let f = conf(&threshold(sc, (deg as f64).to_radians())).metrics().f1;
@@ -217,7 +226,7 @@ fn score(o: &Opts, mesh: &TriMesh, truth: &[bool], times: &mut [f64; 2]) -> Row 
     times[0] += t0.elapsed().as_secs_f64();
     let pairs = EdgePairs::new(&em);
     let t1 = Instant::now();
-    let sweep = |angles: &[f64]| -> (f64, Confusion) {
+    let sweep = |angles: &[f64], theta: f64| -> (f64, Confusion) {
         let labellings: Vec<Vec<bool>> = (0..o.samples)
             .map(|i| {
                 let p = PottsParams {
@@ -230,11 +239,16 @@ fn score(o: &Opts, mesh: &TriMesh, truth: &[bool], times: &mut [f64; 2]) -> Row 
         let auc = sweep_auc(&labellings, truth)
             .map(|r| r.0)
             .unwrap_or(f64::NAN);
-        let l = potts_labels(&em, &pairs, angles, &o.potts).expect("cut");
+        let p = PottsParams {
+            theta_true: theta,
+            ..o.potts
+        };
+        let l = potts_labels(&em, &pairs, angles, &p).expect("cut");
         (auc, conf(&l))
     };
-    let (auc_dg, c_dg) = sweep(&em.dihedral);
-    let (auc_tg, c_tg) = sweep(&tan);
+    let (auc_dg, c_dg) = sweep(&em.dihedral, o.potts.theta_true);
+    let (auc_tg, c_tg) = sweep(&tan, o.potts.theta_true);
+    let (auc_fg, c_fg) = sweep(&filt, tf);
     times[1] += t1.elapsed().as_secs_f64();
     Row {
         auc: [
@@ -243,6 +257,8 @@ fn score(o: &Opts, mesh: &TriMesh, truth: &[bool], times: &mut [f64; 2]) -> Row 
             auc_of(&tan),
             auc_dg,
             auc_tg,
+            auc_of(&filt),
+            auc_fg,
         ],
         conf: [
             conf(&threshold(&em.dihedral, t)),
@@ -250,6 +266,8 @@ fn score(o: &Opts, mesh: &TriMesh, truth: &[bool], times: &mut [f64; 2]) -> Row 
             conf(&threshold(&tan, t)),
             c_dg,
             c_tg,
+            conf(&threshold(&filt, tf)),
+            c_fg,
         ],
     }
 }
@@ -281,9 +299,9 @@ fn main() {
             print!("{m:>22}");
         }
         println!();
-        let mut sum = [0.0; 5];
+        let mut sum = [0.0; NM];
         let mut n = 0;
-        let mut tot = [Confusion::default(); 5];
+        let mut tot = [Confusion::default(); NM];
         for c in &cs {
             let mesh = if noisy {
                 add_noise(&c.mesh, o.noise, 7).expect("noise")
@@ -293,7 +311,7 @@ fn main() {
             let pos = c.truth.iter().filter(|&&t| t).count();
             print!("{:<26}{:>8}{:>6}", c.name, c.truth.len(), pos);
             let r = score(&o, &mesh, &c.truth, &mut times);
-            for k in 0..5 {
+            for k in 0..NM {
                 let m = r.conf[k].metrics();
                 if o.compact {
                     print!("{:>8.2} {:.2}", 100.0 * r.auc[k], m.f1);
@@ -309,14 +327,14 @@ fn main() {
             }
             println!();
             if pos > 0 {
-                for k in 0..5 {
+                for k in 0..NM {
                     sum[k] += r.auc[k];
                 }
                 n += 1;
             }
         }
         print!("{:<40}", "mean AUC / pooled F1");
-        for k in 0..5 {
+        for k in 0..NM {
             let m = tot[k].metrics();
             print!(
                 "{:>8.2} ({:.2}/{:>5.0})",

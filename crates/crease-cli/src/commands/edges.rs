@@ -23,10 +23,10 @@ pub struct EdgesArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// The method (default: the most accurate measured on noisy meshes).
-    #[arg(long, value_enum, default_value_t = MethodArg::Learned)]
+    #[arg(long, value_enum, default_value_t = MethodArg::Filtered)]
     pub method: MethodArg,
-    /// Threshold angle, degrees: of `dihedral` and `tangent`, the high threshold of
-    /// `hysteresis` (the low one is half), θ_true of the `potts-*` data term.
+    /// Threshold angle, degrees: of `dihedral`, `tangent` and `filtered`, the high threshold
+    /// of `hysteresis` (the low one is half), θ_true of the `potts-*` data term.
     #[arg(long)]
     pub threshold: Option<f64>,
     /// Scales of the tangent-plane angle, fractions of the bounding box's smallest side
@@ -69,6 +69,10 @@ pub enum MethodArg {
     Learned,
     /// Potts energy with the SVM data term (equation 2), minimised exactly by a graph cut.
     PottsLearned,
+    /// Dihedral angle of bilaterally filtered face normals above the threshold.
+    Filtered,
+    /// Potts energy with the filtered dihedral angle as data term.
+    PottsFiltered,
 }
 
 impl From<MethodArg> for EdgeMethod {
@@ -81,6 +85,8 @@ impl From<MethodArg> for EdgeMethod {
             MethodArg::PottsTangent => EdgeMethod::PottsTangent,
             MethodArg::Learned => EdgeMethod::Learned,
             MethodArg::PottsLearned => EdgeMethod::PottsLearned,
+            MethodArg::Filtered => EdgeMethod::Filtered,
+            MethodArg::PottsFiltered => EdgeMethod::PottsFiltered,
         }
     }
 }
@@ -104,6 +110,7 @@ pub fn run(g: &Global, a: &EdgesArgs) -> anyhow::Result<()> {
         }
         params.threshold_degrees = t;
         params.potts.theta_true = t.to_radians();
+        params.filtered_degrees = t;
     }
     if !a.scales.is_empty() {
         if let Some(s) = a.scales.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
@@ -189,6 +196,8 @@ pub fn run(g: &Global, a: &EdgesArgs) -> anyhow::Result<()> {
             "boundary_edges": boundary, "flipped_faces": flipped,
             "polylines": n_lines, "closed_loops": closed,
             "threshold_degrees": params.threshold_degrees,
+            "filtered_degrees": params.filtered_degrees,
+            "filter_iterations": params.filter_iterations,
             "tangent_scales": params.tangent.scales,
             "potts": params.potts,
             "model": a.model,

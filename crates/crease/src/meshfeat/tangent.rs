@@ -337,17 +337,26 @@ pub fn accept_angle(em: &EdgeMesh, params: &TangentParams) -> f64 {
     let Some(k) = params.noise_accept else {
         return base;
     };
+    match median_dihedral(em) {
+        Some(median) => base.max((k * median).min(85f64.to_radians())),
+        None => base,
+    }
+}
+
+/// The median dihedral angle (radians) over the edges with two faces; `None` without such
+/// an edge.
+pub fn median_dihedral(em: &EdgeMesh) -> Option<f64> {
     let mut angles: Vec<f64> = (0..em.topo.num_edges())
         .filter(|&e| em.topo.edge_faces(e).len() == 2)
         .map(|e| em.dihedral[e])
         .filter(|d| d.is_finite())
         .collect();
     if angles.is_empty() {
-        return base;
+        return None;
     }
     let mid = angles.len() / 2;
     let (_, median, _) = angles.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
-    base.max((k * *median).min(85f64.to_radians()))
+    Some(*median)
 }
 
 /// Fills `out` (one angle per scale) for edge `e`; leaves π for edges without two faces.
