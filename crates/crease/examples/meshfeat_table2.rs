@@ -1,7 +1,8 @@
 //! Reproduces Table 2 of vidal et al. 2011 on the meshes crease has: per-edge AUC of dihedral
 //! thresholding, hysteresis thresholding, the tangent-plane angle, and the Potts energy with the
-//! dihedral and the tangent-plane data terms, on clean and noisy meshes (0.5 % Gaussian noise
-//! of the bounding box's largest side, section 6.1).
+//! dihedral and the tangent-plane data terms, and crease's default, the dihedral angle of
+//! bilaterally filtered normals (`filtered`, alone and as the Potts data term), on clean and
+//! noisy meshes (0.5 % Gaussian noise of the bounding box's largest side, section 6.1).
 //!
 //! ```text
 //! cargo run --release -p crease --example meshfeat_table2 [-- [--samples N] [--only NAME]
