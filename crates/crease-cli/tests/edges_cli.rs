@@ -33,13 +33,21 @@ fn cube_edges_lines_and_edge_element() {
     );
     let out = dir.path().join("edges.ply");
     let lines = dir.path().join("lines.obj");
-    // The default method (the filtered dihedral angle) is exact on the clean cube: its 240
-    // edges; the learned classifier with the shipped model finds them and a few beside the
-    // corners (measured: 244 of 7200 edges).
+    // The default method (`fused`: the SVM and the filtered dihedral angle) and `filtered`
+    // are exact on the clean cube: its 240 edges; the learned classifier with the shipped
+    // model finds them and a few beside the corners (measured: 244 of 7200 edges).
     let a = run("edges", &input, &out, &["--json", "-q"]).success();
     let s = json_of(&a.get_output().stdout);
-    assert_eq!(s["method"], "filtered");
+    assert_eq!(s["method"], "fused");
     assert_eq!(s["sharp_edges"], 240);
+    let a = run(
+        "edges",
+        &input,
+        &out,
+        &["--method", "filtered", "--json", "-q"],
+    )
+    .success();
+    assert_eq!(json_of(&a.get_output().stdout)["sharp_edges"], 240);
     let a = run(
         "edges",
         &input,

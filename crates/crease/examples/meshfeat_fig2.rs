@@ -1,5 +1,5 @@
 //! The paper's Fig. 2 (vidal et al. 2011): feature edges of noisy fandisk at a false-positive
-//! rate of 1e-4, for the ground truth, crease's default method (`filtered`), its Potts
+//! rate of 1e-4, for the ground truth, crease's default method (`fused`), `filtered` and its Potts
 //! labelling (`potts-filtered`, equation 1 with the filtered angle as the data term of
 //! equation 5; the decision angle chosen for that rate), dihedral thresholding and hysteresis
 //! thresholding. Each method's threshold is the one at which at
@@ -13,15 +13,16 @@
 //! NOISE is relative to the bounding box's largest side (default 0.005, the section 6.1
 //! protocol; 0.002 is the level at which our dihedral thresholding scores what the paper's
 //! Table 2 reports for it). MESH defaults to `../shared/data/meshes/fandisk.off`, labelled by
-//! `meshfeat::CLASSIC_LABELS`. Writes `OUTDIR/fig2-{truth,filtered,potts-filtered,dihedral,hysteresis}.png`
+//! `meshfeat::CLASSIC_LABELS`. Writes `OUTDIR/fig2-{truth,fused,filtered,potts-filtered,dihedral,hysteresis}.png`
 //! and prints each method's true-positive rate at that point.
 
 use std::path::{Path, PathBuf};
 
 use crease::geometry::TriMesh;
 use crease::meshfeat::{
-    add_noise, classic_label_degrees, dihedral_labels, feature_polylines, filtered_dihedral,
-    hysteresis_scores, potts_labels, EdgeMesh, EdgePairs, EdgeParams, PottsParams,
+    add_noise, classic_label_degrees, default_model, dihedral_labels, feature_polylines,
+    filtered_dihedral, fused_scores, hysteresis_scores, learned_scores, potts_labels, EdgeMesh,
+    EdgePairs, EdgeParams, PottsParams,
 };
 use crease::render::{Polyline, RenderParams, Scene, View, ViewLayout};
 
@@ -101,6 +102,14 @@ fn main() {
     let d = EdgeParams::default();
     let filtered = filtered_dihedral(&em, d.filter_iterations, &d.bilateral);
     let hyst = hysteresis_scores(&em, &em.dihedral, d.low_ratio).expect("hysteresis");
+    let (decision, _) = learned_scores(&em, default_model()).expect("SVM");
+    let fused = fused_scores(
+        &decision,
+        &filtered,
+        0.0,
+        d.filtered_degrees,
+        d.fused_svm_weight,
+    );
     let fpr = 1e-4;
     // potts-filtered: the decision angle θ_true swept over 1..90°, the labelling with the most
     // true edges among those with at most 1e-4 false ones.
@@ -140,6 +149,7 @@ fn main() {
         );
     }
     for (method, score) in [
+        ("fused", &fused),
         ("filtered", &filtered),
         ("dihedral", &em.dihedral),
         ("hysteresis", &hyst),

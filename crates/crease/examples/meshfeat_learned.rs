@@ -1,7 +1,8 @@
 //! Table 2 of vidal et al. 2011 for the learned methods: per-edge AUC of the SVM decision value
-//! (`learned`) and of equation 1 with the SVM data term (`potts-learned`, ROC by sweeping the
-//! bias over [−2, 1] as section 6.3), next to dihedral thresholding and the tangent-plane
-//! angle, on the meshes of `examples/meshfeat_table2.rs`, clean and noisy (0.5 % Gaussian
+//! (`learned`), of equation 1 with the SVM data term (`potts-learned`, ROC by sweeping the
+//! bias over [−2, 1] as section 6.3) and of crease's default `fused` (the decision value with
+//! the filtered dihedral angle, `meshfeat::fused_scores`), next to dihedral thresholding and
+//! the tangent-plane angle, on the meshes of `examples/meshfeat_table2.rs`, clean and noisy (0.5 % Gaussian
 //! noise of the bounding box's largest side, seed 7; `--noise R` for R × that side, e.g. 0.002,
 //! the level at which our dihedral thresholding scores what the paper reports for it).
 //!
@@ -27,9 +28,9 @@ use crease::geometry::TriMesh;
 use crease::meshfeat::svm::train;
 use crease::meshfeat::{
     add_noise, classic_label_degrees, default_model, dihedral_labels, edge_features,
-    labels_from_pairs, mean_tangent_angle, potts_labels_unary, read_abc_sharp_edges, svm_unary,
-    sweep_auc, tangent_angles, EdgeFeatures, EdgeMesh, EdgePairs, EdgeParams, SvmModel,
-    TrainParams, TrainingSet,
+    filtered_dihedral, fused_scores, labels_from_pairs, mean_tangent_angle, potts_labels_unary,
+    read_abc_sharp_edges, svm_unary, sweep_auc, tangent_angles, EdgeFeatures, EdgeMesh, EdgePairs,
+    EdgeParams, SvmModel, TrainParams, TrainingSet,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -178,9 +179,11 @@ fn tpr_at(r: &Roc, fpr: f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// AUC, TPR at FPR 1e-4, (TPR, FPR) at d > 0 of the learned method; AUC of potts-learned.
+/// AUC, TPR at FPR 1e-4, (TPR, FPR) at d > 0 of the learned method; AUC of potts-learned
+/// and of `fused` (the SVM with the filtered dihedral angle, `meshfeat::fused_scores`).
 struct Scores {
     auc: f64,
+    fused_auc: f64,
     tpr4: f64,
     tpr0: f64,
     fpr0: f64,
@@ -214,8 +217,19 @@ fn score(o: &Opts, v: &Version, truth: &[bool], model: &SvmModel) -> Scores {
     } else {
         f64::NAN
     };
+    let d_params = EdgeParams::default();
+    let filtered = filtered_dihedral(&em, d_params.filter_iterations, &d_params.bilateral);
+    let fused = fused_scores(
+        &d,
+        &filtered,
+        0.0,
+        d_params.filtered_degrees,
+        d_params.fused_svm_weight,
+    );
+    let fused_auc = roc(&fused, truth).map(|r| r.auc).unwrap_or(f64::NAN);
     Scores {
         auc,
+        fused_auc,
         tpr4,
         tpr0: tp / pos,
         fpr0: fp / neg,
@@ -331,7 +345,7 @@ fn main() {
     for (k, noisy) in [false, true].into_iter().enumerate() {
         println!(
             "\n{} models: AUC % (dihedral thresholding, tangent, learned default / LOO, \
-             potts-learned default / LOO); TPR % at FPR 1e-4 and TPR/FPR(x1e-4) at d > 0 of learned LOO",
+             potts-learned default / LOO, fused default / LOO); TPR % at FPR 1e-4 and TPR/FPR(x1e-4) at d > 0 of learned LOO",
             if noisy {
                 format!("b) noisy ({} % GN)", 100.0 * o.noise)
             } else {
@@ -339,7 +353,7 @@ fn main() {
             }
         );
         println!(
-            "{:<22}{:>7}{:>6}{:>8}{:>8}{:>9}{:>8}{:>9}{:>8}{:>10}{:>14}",
+            "{:<22}{:>7}{:>6}{:>8}{:>8}{:>9}{:>8}{:>9}{:>8}{:>9}{:>8}{:>10}{:>14}",
             "mesh",
             "#edges",
             "#f.e.",
@@ -349,11 +363,13 @@ fn main() {
             "LOO",
             "p-lrn-D",
             "LOO",
+            "fused-D",
+            "LOO",
             "TPR@1e-4",
             "TPR/FPR d>0"
         );
-        let mut sums = [0.0; 6];
-        let mut sums_classic = [0.0; 6];
+        let mut sums = [0.0; 8];
+        let mut sums_classic = [0.0; 8];
         let (mut n, mut nc) = (0, 0);
         for (s, &i) in selected.iter().enumerate() {
             let c = &all[i];
@@ -372,13 +388,15 @@ fn main() {
                 sl.auc,
                 sd.potts_auc,
                 sl.potts_auc,
+                sd.fused_auc,
+                sl.fused_auc,
             ];
             print!("{:<22}{:>7}{:>6}", c.name, c.truth.len(), pos);
             for (j, a) in row.iter().enumerate() {
                 print!(
                     "{:>w$.2}",
                     100.0 * a,
-                    w = if j == 2 || j == 4 { 9 } else { 8 }
+                    w = if j == 2 || j == 4 || j == 6 { 9 } else { 8 }
                 );
             }
             println!(
@@ -388,7 +406,7 @@ fn main() {
                 1e4 * sl.fpr0
             );
             if pos > 0 {
-                for j in 0..6 {
+                for j in 0..8 {
                     sums[j] += row[j];
                     if !c.synthetic {
                         sums_classic[j] += row[j];
@@ -409,7 +427,7 @@ fn main() {
                 print!(
                     "{:>w$.2}",
                     100.0 * a / m.max(1) as f64,
-                    w = if j == 2 || j == 4 { 9 } else { 8 }
+                    w = if j == 2 || j == 4 || j == 6 { 9 } else { 8 }
                 );
             }
             println!();

@@ -215,15 +215,17 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
     }
 
     // 4c. Feature edges of the mesh with the noise of vidal 2011 section 6.1 (0.5 % of the
-    // largest side): crease's default `filtered` against dihedral thresholding (what CGAL,
-    // libigl and MeshLab do), scored against the exact sharp edges.
+    // largest side): crease's default `fused` (the paper's SVM and the filtered dihedral
+    // angle), `filtered` alone, and dihedral thresholding (what CGAL, libigl and MeshLab do),
+    // scored against the exact sharp edges.
     let s = Stage::start("mesh feature edges", g.quiet);
     let noisy_mesh = crease::meshfeat::add_noise(&m.mesh, 0.005, 1)?;
     let em = crease::meshfeat::EdgeMesh::new(&noisy_mesh)?;
     let (edge_truth, _) = crease::meshfeat::labels_from_pairs(&em.topo, &m.sharp_edges);
     let mut edge_scores = serde_json::Map::new();
-    let mut filtered_sharp = Vec::new();
+    let mut default_sharp = Vec::new();
     for method in [
+        crease::meshfeat::EdgeMethod::Fused,
         crease::meshfeat::EdgeMethod::Filtered,
         crease::meshfeat::EdgeMethod::Dihedral,
     ] {
@@ -238,11 +240,11 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
             method.name().to_string(),
             serde_json::json!({ "auc": auc, "exact": c.metrics(), "detected": c.tp + c.fp }),
         );
-        if method == crease::meshfeat::EdgeMethod::Filtered {
-            filtered_sharp = d.sharp;
+        if method == crease::meshfeat::EdgeParams::default().method {
+            default_sharp = d.sharp;
         }
     }
-    let edge_lines = crease::meshfeat::feature_polylines(&em.topo, &filtered_sharp);
+    let edge_lines = crease::meshfeat::feature_polylines(&em.topo, &default_sharp);
     let mut edges_geom = crease::io::Geometry::from_cloud(noisy_mesh.vertices.clone());
     edges_geom.polylines = edge_lines.clone();
     super::save(g, &dir.join("part-edges.obj"), &edges_geom, false, &[])?;
@@ -391,7 +393,7 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
     };
     let params = RenderParams {
         title: Some(format!(
-            "{SHAPE}, noisy mesh (0.5 %): feature edges (filtered)"
+            "{SHAPE}, noisy mesh (0.5 %): feature edges (fused)"
         )),
         ..Default::default()
     };
@@ -519,7 +521,9 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
         let auc_of = |m: &str| result["mesh_feature_edges"]["methods"][m]["auc"].as_f64();
         let f1_of = |m: &str| result["mesh_feature_edges"]["methods"][m]["exact"]["f1"].as_f64();
         println!(
-            "mesh feature edges (Vidal 2011, noisy mesh): filtered AUC {:.3}, F1 {:.3}; dihedral thresholding AUC {:.3}, F1 {:.3}.",
+            "mesh feature edges (Vidal 2011, noisy mesh): fused AUC {:.3}, F1 {:.3}; filtered {:.3}, {:.3}; dihedral thresholding {:.3}, {:.3}.",
+            auc_of("fused").unwrap_or(f64::NAN),
+            f1_of("fused").unwrap_or(f64::NAN),
             auc_of("filtered").unwrap_or(f64::NAN),
             f1_of("filtered").unwrap_or(f64::NAN),
             auc_of("dihedral").unwrap_or(f64::NAN),
