@@ -70,8 +70,9 @@ pub enum Command {
     /// Score a labelled output against ground truth: precision, recall, F1, MCC, IoU, tolerant
     /// scores, ROC and AUC.
     Eval(crate::commands::eval::EvalArgs),
-    /// Feature edges of a triangle mesh that survive noise (tangent-plane angle, Potts energy
-    /// minimised by a graph cut; dihedral and hysteresis thresholding as baselines).
+    /// Feature edges of a triangle mesh that survive noise (the learned classifier fused with
+    /// bilaterally filtered normals by default; tangent-plane angle, Potts energy minimised by
+    /// a graph cut; dihedral and hysteresis thresholding as baselines).
     Edges(crate::commands::edges::EdgesArgs),
     /// Train the learned edge classifier (RBF SVM) on meshes with ground truth.
     Train(crate::commands::train::TrainArgs),
