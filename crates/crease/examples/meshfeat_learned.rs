@@ -166,6 +166,8 @@ fn cases(o: &Opts) -> Vec<Case> {
 struct Version {
     mesh: TriMesh,
     features: EdgeFeatures,
+    /// The filtered dihedral angle (`fused` reads it with every model's decision values).
+    filtered: Vec<f64>,
     dihedral_auc: f64,
     tangent_auc: f64,
 }
@@ -218,10 +220,9 @@ fn score(o: &Opts, v: &Version, truth: &[bool], model: &SvmModel) -> Scores {
         f64::NAN
     };
     let d_params = EdgeParams::default();
-    let filtered = filtered_dihedral(&em, d_params.filter_iterations, &d_params.bilateral);
     let fused = fused_scores(
         &d,
-        &filtered,
+        &v.filtered,
         0.0,
         d_params.filtered_degrees,
         d_params.fused_svm_weight,
@@ -270,10 +271,13 @@ fn main() {
                     &tangent_angles(&em, &EdgeParams::default().tangent).expect("tangent"),
                 );
                 let tangent_auc = auc(&tan);
+                let p = EdgeParams::default();
+                let filtered = filtered_dihedral(&em, p.filter_iterations, &p.bilateral);
                 drop(em);
                 Version {
                     mesh,
                     features,
+                    filtered,
                     dihedral_auc,
                     tangent_auc,
                 }

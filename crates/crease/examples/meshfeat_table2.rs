@@ -359,10 +359,7 @@ fn main() {
                 let width = o.noise
                     * crease::geometry::Aabb::from_points(c.mesh.positions())
                         .map_or(0.0, |b| b.max_side());
-                sliver_edges(&em, &c.mesh, width)
-                    .iter()
-                    .map(|&s| !s)
-                    .collect()
+                sliver_edges(&em, width).iter().map(|&s| !s).collect()
             } else {
                 vec![true; c.truth.len()]
             };

@@ -6,6 +6,7 @@ mod common;
 
 use crease::eval::roc::roc;
 use crease::eval::Confusion;
+use crease::geometry::TriMesh;
 use crease::meshfeat::{
     add_noise, classic_label_degrees, detect_prepared, dihedral_labels, filtered_dihedral,
     labels_from_pairs, mean_tangent_angle, sliver_edges, tangent_angles, BilateralParams, EdgeMesh,
@@ -15,6 +16,17 @@ use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
 fn auc(score: &[f64], truth: &[bool]) -> f64 {
     roc(score, truth).unwrap().auc
+}
+
+/// A classic mesh of `../shared/data/meshes` and its section 6.1 labels (`CLASSIC_LABELS`).
+fn classic(dir: &std::path::Path, file: &str) -> (TriMesh, Vec<bool>) {
+    let (g, _) = crease::io::read(dir.join("meshes").join(file), &Default::default()).unwrap();
+    let mesh = g.into_mesh().unwrap();
+    let truth = dihedral_labels(
+        &EdgeMesh::new(&mesh).unwrap(),
+        classic_label_degrees(file).unwrap(),
+    );
+    (mesh, truth)
 }
 
 fn with(method: EdgeMethod) -> EdgeParams {
@@ -43,10 +55,8 @@ fn filtered_dihedral_beats_the_paper_estimators_on_noisy_classic_meshes() {
         ("sharp_sphere.off", 0.965),
         ("block.off", 0.0),
     ] {
-        let (g, _) = crease::io::read(dir.join("meshes").join(file), &Default::default()).unwrap();
-        let mesh = g.into_mesh().unwrap();
+        let (mesh, truth) = classic(&dir, file);
         let em = EdgeMesh::new(&mesh).unwrap();
-        let truth = dihedral_labels(&em, classic_label_degrees(file).unwrap());
         let clean = auc(&filtered_dihedral(&em, FILTER_ITERATIONS, &bp), &truth);
         assert!(clean > 0.999, "{file} clean: AUC {clean}");
         if noisy_min == 0.0 {
@@ -83,14 +93,12 @@ fn filtered_dihedral_is_above_99_percent_at_the_papers_noise() {
         ("bar.off", 0.995),
         ("block.off", 0.99),
     ] {
-        let (g, _) = crease::io::read(dir.join("meshes").join(file), &Default::default()).unwrap();
-        let mesh = g.into_mesh().unwrap();
+        let (mesh, truth) = classic(&dir, file);
         let clean = EdgeMesh::new(&mesh).unwrap();
-        let truth = dihedral_labels(&clean, classic_label_degrees(file).unwrap());
         let side = crease::geometry::Aabb::from_points(mesh.positions())
             .unwrap()
             .max_side();
-        let keep: Vec<bool> = sliver_edges(&clean, &mesh, 0.002 * side)
+        let keep: Vec<bool> = sliver_edges(&clean, 0.002 * side)
             .iter()
             .map(|&s| !s)
             .collect();
@@ -212,12 +220,7 @@ fn fused_beats_filtered_and_learned_at_the_papers_noise() {
         ("block.off", 0.97),
         ("sharp_sphere.off", 0.985),
     ] {
-        let (g, _) = crease::io::read(dir.join("meshes").join(file), &Default::default()).unwrap();
-        let mesh = g.into_mesh().unwrap();
-        let truth = dihedral_labels(
-            &EdgeMesh::new(&mesh).unwrap(),
-            classic_label_degrees(file).unwrap(),
-        );
+        let (mesh, truth) = classic(&dir, file);
         let noisy = add_noise(&mesh, 0.002, 7).unwrap();
         let em = EdgeMesh::new(&noisy).unwrap();
         let fused = detect_prepared(&em, &with(EdgeMethod::Fused)).unwrap();

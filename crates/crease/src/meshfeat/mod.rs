@@ -28,8 +28,9 @@
 //!   equation 5 (mean AUC on the 11 meshes of Table 2: 97.4 % at the 0.5 % noise of our
 //!   protocol, the SVM 95.1 %; 98.96 % at 0.2 %, the noise at which our dihedral thresholding
 //!   scores what the paper reports for it, 97.2 % against 97.3 %). Its filtered dihedral
-//!   angle as three more SVM features was measured too and did not help the learned classifier (noisy mean 95.02 % shipped, 94.94 % leave-one-out),
-//!   nor did the point-cloud sharp stage's sharpness at the vertices (94.69 % / 95.53 %);
+//!   angle as three more SVM features was measured too and did not help the learned
+//!   classifier (noisy mean 95.02 % shipped, 94.94 % leave-one-out), nor did the point-cloud
+//!   sharp stage's sharpness at the vertices (94.69 % / 95.53 %);
 //! * `fused` (the default, crease's addition): the SVM decision value and the filtered angle
 //!   combined ([`fused_scores`]), better than either on every noise level measured.
 
@@ -455,9 +456,6 @@ pub fn detect_prepared(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetecti
         )));
     }
     let mut timings = EdgeTimings::default();
-    if params.method.uses_model() {
-        return detect_learned(em, params);
-    }
     if params.method.uses_filter()
         && !(params.filtered_degrees.is_finite() && params.filtered_degrees >= 0.0)
     {
@@ -465,6 +463,9 @@ pub fn detect_prepared(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetecti
             "feature edges: the filtered threshold must be finite and >= 0 degrees, got {}",
             params.filtered_degrees
         )));
+    }
+    if params.method.uses_model() {
+        return detect_learned(em, params);
     }
     let t0 = Instant::now();
     let angles = if params.method.uses_tangent() {
@@ -582,11 +583,11 @@ fn detect_learned(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetection> {
         ..EdgeTimings::default()
     };
     if params.method == EdgeMethod::Fused {
-        if !(params.filtered_degrees.is_finite() && params.filtered_degrees > 0.0) {
-            return Err(Error::InvalidArgument(format!(
-                "feature edges: the filtered threshold must be finite and > 0 degrees, got {}",
-                params.filtered_degrees
-            )));
+        // Finite and >= 0 is checked by `detect_prepared`; `fused` divides by it.
+        if params.filtered_degrees == 0.0 {
+            return Err(Error::InvalidArgument(
+                "feature edges: the filtered threshold of `fused` must be > 0 degrees".into(),
+            ));
         }
         if !(0.0..=1.0).contains(&params.fused_svm_weight) {
             return Err(Error::InvalidArgument(format!(
