@@ -70,7 +70,8 @@ pub enum MethodArg {
     Learned,
     /// Potts energy with the SVM data term (equation 2), minimised exactly by a graph cut.
     PottsLearned,
-    /// Dihedral angle of bilaterally filtered face normals above the threshold.
+    /// Mean dihedral angle of bilaterally and total-variation filtered face normals above the
+    /// threshold.
     Filtered,
     /// Potts energy with the filtered dihedral angle as data term.
     PottsFiltered,

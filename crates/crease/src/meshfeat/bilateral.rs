@@ -1,7 +1,8 @@
 //! Feature-preserving smoothing of the face normals of a noisy mesh: bilateral normal filtering
 //! (Y. Zheng, H. Fu, O. K.-C. Au, C.-L. Tai, "Bilateral normal filtering for mesh denoising",
-//! IEEE TVCG 17(10), 2011, equation 4), the source of the `filtered` and `potts-filtered`
-//! methods' angle ([`super::filtered_dihedral`]).
+//! IEEE TVCG 17(10), 2011, equation 4), one of the two sources of the `filtered` and
+//! `potts-filtered` methods' angle ([`super::filtered_dihedral`]; the other is
+//! [`super::tv`]). The figures below are of the bilateral angle alone.
 //!
 //! **Why (crease's addition to vidal et al. 2011).** At the noise of section 6.1 (Gaussian,
 //! 0.5 % of the bounding box's largest side: 0.3 to 0.5 edge lengths on our meshes) adjacent
