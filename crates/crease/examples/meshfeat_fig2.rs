@@ -100,7 +100,7 @@ fn main() {
     let noisy = add_noise(&clean, noise, 7).expect("noise");
     let em = EdgeMesh::new(&noisy).expect("topology");
     let d = EdgeParams::default();
-    let filtered = filtered_dihedral(&em, d.filter_iterations, &d.bilateral, &d.tv);
+    let filtered = filtered_dihedral(&em, d.filter_iterations, &d.bilateral, &d.tv, &d.line);
     let hyst = hysteresis_scores(&em, &em.dihedral, d.low_ratio).expect("hysteresis");
     let (decision, _) = learned_scores(&em, default_model()).expect("SVM");
     let fused = fused_scores(

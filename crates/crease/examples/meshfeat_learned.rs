@@ -304,7 +304,8 @@ fn main() {
                 );
                 let tangent_auc = auc(&tan);
                 let p = EdgeParams::default();
-                let filtered = filtered_dihedral(&em, p.filter_iterations, &p.bilateral, &p.tv);
+                let filtered =
+                    filtered_dihedral(&em, p.filter_iterations, &p.bilateral, &p.tv, &p.line);
                 drop(em);
                 Version {
                     mesh,

@@ -222,7 +222,7 @@ fn score(o: &Opts, mesh: &TriMesh, truth: &[bool], keep: &[bool], times: &mut [f
     )
     .expect("tangent");
     let tan = mean_tangent_angle(&ta);
-    let filt = filtered_dihedral(&em, d.filter_iterations, &d.bilateral, &d.tv);
+    let filt = filtered_dihedral(&em, d.filter_iterations, &d.bilateral, &d.tv, &d.line);
     let tf = d.filtered_degrees.to_radians();
     let hys = hysteresis_scores(&em, &em.dihedral, d.low_ratio).expect("hysteresis");
     let t = d.threshold_degrees.to_radians();

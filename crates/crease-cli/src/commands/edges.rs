@@ -75,7 +75,7 @@ pub enum MethodArg {
     Filtered,
     /// Potts energy with the filtered dihedral angle as data term.
     PottsFiltered,
-    /// The SVM decision value and the filtered dihedral angle combined (0.2 d + 0.8 (θ / 25° − 1)
+    /// The SVM decision value and the filtered dihedral angle combined (0.1 d + 0.9 (θ / 25° − 1)
     /// above 0): the most accurate on clean and noisy meshes.
     Fused,
 }

@@ -20,7 +20,7 @@
 //!
 //! **Choices, measured** (mean AUC over the 11 meshes of `examples/meshfeat_table2.rs`, of
 //! the `fused` score with this angle averaged with the bilateral one, clean / 0.2 % / 0.5 %
-//! noise of the largest side):
+//! noise of the largest side; SVM weight 0.2, before the line smoothing of [`super::line`]):
 //! - A fixed number of sweeps, [`TvParams::sweeps`] = 20, started from the normals after one
 //!   bilateral iteration: 100.00 / 99.67 / 98.70 %. Started from the second iteration, 20 /
 //!   30 / 50 / 80 sweeps scored 98.66 / 98.68 / 98.68 / 98.63 % at 0.5 %. Running towards

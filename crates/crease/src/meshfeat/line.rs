@@ -1,0 +1,202 @@
+//! Smoothing of an edge score along the line the edge lies on (crease's addition to vidal et al.
+//! 2011): the last step of the `filtered` angle ([`super::filtered_dihedral`]).
+//!
+//! A feature line is a chain of mesh edges that continue each other; noise is not. Each edge's
+//! score is blended with its mean over its own chain: from each endpoint the walk takes the
+//! incident edge that continues the current one most straightly (turning by at most
+//! [`LineParams::max_turn_degrees`]) for [`LineParams::steps`] edges, and
+//!
+//! s'(e) = (1 − β) s(e) + β · mean(s over e and the edges walked), β = [`LineParams::weight`].
+//!
+//! The walk follows the mesh geometry, never the score, so the along-line neighbours of an edge
+//! beside a crease are the edges beside the crease too: a diagonal edge touching a crease has
+//! no straight continuation of high score and loses, a crease edge of low noisy angle borrows
+//! from its neighbours on the crease.
+//!
+//! **Measured** (mean AUC over the 11 meshes of `examples/meshfeat_table2.rs`, clean / 0.2 % /
+//! 0.5 % noise of the largest side; `filtered` / `fused` with the SVM weight 0.1):
+//! - without the smoothing: 100.00 / 99.15 / 98.63 % and 100.00 / 99.59 / 98.81 %;
+//! - steps 2, β = 0.2, 45°: **100.00 / 99.62 / 98.80 %** and **100.00 / 99.72 / 98.86 %**;
+//! - β = 0.3: 100.00 / 99.64 / 98.80 % and 99.99 / 99.71 / 98.84 %; β = 0.5: `filtered` 99.98 /
+//!   99.61 / 98.71 %; 1 step, β = 0.3: 100.00 / 99.56 / 98.78 %; 3 steps, β = 0.5: 99.98 /
+//!   99.59 / 98.64 %;
+//! - a largest turn of 60° or 32° instead of 45°: `fused` 98.83 and 98.86 % at 0.5 %.
+//!
+//! An earlier attempt that rescored an edge by the best-scoring continuation at each endpoint
+//! (choosing by the score, not by the geometry) lowered the mean AUC (96.2–96.4 % against
+//! 97.42 % for the bilateral angle of the time): it rewarded the edges beside a crease too.
+//!
+//! Parallel over the edges; each value depends only on the mesh and the scores.
+
+use rayon::prelude::*;
+
+use super::EdgeMesh;
+use crate::geometry::vec3;
+
+/// Parameters of [`smooth_along_lines`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LineParams {
+    /// Edges walked from each endpoint (0: no smoothing).
+    pub steps: usize,
+    /// β, the weight of the chain's mean, in [0, 1].
+    pub weight: f64,
+    /// The largest turn between consecutive edges of a chain, degrees.
+    pub max_turn_degrees: f64,
+}
+
+impl Default for LineParams {
+    fn default() -> Self {
+        LineParams {
+            steps: 2,
+            weight: 0.2,
+            max_turn_degrees: 45.0,
+        }
+    }
+}
+
+impl LineParams {
+    /// `None` if the parameters are valid, else what is wrong.
+    pub fn invalid(&self) -> Option<String> {
+        if !(0.0..=1.0).contains(&self.weight) {
+            return Some(format!(
+                "line smoothing: the weight must be in [0, 1], got {}",
+                self.weight
+            ));
+        }
+        if !(self.max_turn_degrees.is_finite() && (0.0..=180.0).contains(&self.max_turn_degrees)) {
+            return Some(format!(
+                "line smoothing: the largest turn must be in [0, 180] degrees, got {}",
+                self.max_turn_degrees
+            ));
+        }
+        None
+    }
+}
+
+/// The edge leaving vertex `v` that continues edge `e` (which ends at `v`) most straightly,
+/// turning by less than the angle of cosine `min_cos`, and its far vertex.
+fn continuation(em: &EdgeMesh, e: usize, v: u32, min_cos: f64) -> Option<(usize, u32)> {
+    let edges = em.topo.edges();
+    let p = em.mesh.positions();
+    let other = |e: usize, v: u32| {
+        let [a, b] = edges[e];
+        if a == v {
+            b
+        } else {
+            a
+        }
+    };
+    let incoming = vec3::normalize(vec3::sub(p[v as usize], p[other(e, v) as usize]))?;
+    let mut best: Option<(f64, usize, u32)> = None;
+    for &e2 in em.topo.vertex_edges(v as usize) {
+        let e2 = e2 as usize;
+        if e2 == e {
+            continue;
+        }
+        let w = other(e2, v);
+        let Some(out) = vec3::normalize(vec3::sub(p[w as usize], p[v as usize])) else {
+            continue;
+        };
+        let c = vec3::dot(incoming, out);
+        if c > min_cos && best.is_none_or(|b| c > b.0) {
+            best = Some((c, e2, w));
+        }
+    }
+    best.map(|(_, e2, w)| (e2, w))
+}
+
+/// `score` (one value per edge of `em`) smoothed along the lines (see the module
+/// documentation).
+pub fn smooth_along_lines(em: &EdgeMesh, score: &[f64], params: &LineParams) -> Vec<f64> {
+    if params.steps == 0 || params.weight == 0.0 {
+        return score.to_vec();
+    }
+    let min_cos = params.max_turn_degrees.to_radians().cos();
+    let edges = em.topo.edges();
+    let beta = params.weight;
+    (0..edges.len())
+        .into_par_iter()
+        .map(|e| {
+            let mut sum = score[e];
+            let mut n = 1.0;
+            for start in edges[e] {
+                let (mut cur, mut v) = (e, start);
+                for _ in 0..params.steps {
+                    match continuation(em, cur, v, min_cos) {
+                        Some((next, w)) => {
+                            sum += score[next];
+                            n += 1.0;
+                            cur = next;
+                            v = w;
+                        }
+                        None => break,
+                    }
+                }
+            }
+            (1.0 - beta) * score[e] + beta * sum / n
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::{mesh as synth_mesh, MeshParams, Shape};
+
+    /// On a cube's mesh, a score of 1 on one edge of each straight line segment and 0 elsewhere
+    /// spreads only along the lines it lies on: the edges walked along a cube edge are cube
+    /// edges, so an indicator of the cube's edges is unchanged.
+    #[test]
+    fn smoothing_follows_straight_lines() {
+        let shape = Shape::from_name("cube").expect("shape");
+        let m = synth_mesh(
+            &shape,
+            &MeshParams {
+                target_edge: Some(shape.aabb().max_side() / 20.0),
+                ..Default::default()
+            },
+        )
+        .expect("mesh");
+        let em = EdgeMesh::new(&m.mesh).expect("topology");
+        let (truth, _) = crate::meshfeat::labels_from_pairs(&em.topo, &m.sharp_edges);
+        let indicator: Vec<f64> = truth.iter().map(|&t| f64::from(u8::from(t))).collect();
+        let s = smooth_along_lines(&em, &indicator, &LineParams::default());
+        // Away from the corners every cube edge continues along its own line.
+        let p = m.mesh.positions();
+        let near_corner = |e: usize| {
+            em.topo.edges()[e].iter().any(|&v| {
+                p[v as usize]
+                    .iter()
+                    .filter(|c| (c.abs() - 0.5).abs() < 0.2)
+                    .count()
+                    == 3
+            })
+        };
+        let mut checked = 0;
+        for e in 0..s.len() {
+            if truth[e] && !near_corner(e) {
+                assert!((s[e] - 1.0).abs() < 1e-12, "edge {e}: {}", s[e]);
+                checked += 1;
+            }
+            if !truth[e] {
+                assert!(s[e] < 0.2 + 1e-12, "edge {e}: {}", s[e]);
+            }
+        }
+        assert!(checked > 50, "{checked} edges checked");
+        let unchanged = smooth_along_lines(
+            &em,
+            &indicator,
+            &LineParams {
+                steps: 0,
+                ..LineParams::default()
+            },
+        );
+        assert_eq!(unchanged, indicator);
+        assert!(LineParams::default().invalid().is_none());
+        let bad = LineParams {
+            weight: -1.0,
+            ..LineParams::default()
+        };
+        assert!(bad.invalid().is_some());
+    }
+}
