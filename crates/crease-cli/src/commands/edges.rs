@@ -205,6 +205,8 @@ pub fn run(g: &Global, a: &EdgesArgs) -> anyhow::Result<()> {
             "filtered_degrees": params.filtered_degrees,
             "fused_svm_weight": params.fused_svm_weight,
             "filter_iterations": params.filter_iterations,
+            "total_variation": params.tv,
+            "line_smoothing": params.line,
             "tangent_scales": params.tangent.scales,
             "potts": params.potts,
             "model": a.model,

@@ -29,12 +29,13 @@
 //! Parallel over the edges; each value depends only on the mesh and the scores.
 
 use rayon::prelude::*;
+use serde::Serialize;
 
 use super::EdgeMesh;
 use crate::geometry::vec3;
 
 /// Parameters of [`smooth_along_lines`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LineParams {
     /// Edges walked from each endpoint (0: no smoothing).
     pub steps: usize,

@@ -41,12 +41,13 @@
 //! [`super::filtered_dihedral`] averages the two.
 
 use rayon::prelude::*;
+use serde::Serialize;
 
 use super::EdgeMesh;
 use crate::geometry::{vec3, Point3};
 
 /// Parameters of [`tv_normals`] (see the module documentation).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TvParams {
     /// λ as a multiple of the mean edge length.
     pub lambda: f64,
