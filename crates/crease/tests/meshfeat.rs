@@ -8,8 +8,8 @@ use crease::eval::Confusion;
 use crease::geometry::TriMesh;
 use crease::meshfeat::{
     accept_angle, add_noise, detect_prepared, dihedral_labels, hysteresis_scores,
-    labels_from_pairs, mean_tangent_angle, potts_labels, read_abc_sharp_edges, tangent_angles,
-    EdgeMesh, EdgeMethod, EdgePairs, EdgeParams, PottsParams, TangentParams, CLASSIC_LABELS,
+    labels_from_pairs, mean_tangent_angle, potts_labels, tangent_angles, EdgeMesh, EdgeMethod,
+    EdgePairs, EdgeParams, PottsParams, TangentParams, CLASSIC_LABELS,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -227,16 +227,7 @@ fn abc_sharp_curves_are_mesh_edges_and_tangent_angle_separates_them() {
     let Some(dir) = common::data_dir() else {
         return;
     };
-    let abc = dir.join("abc");
-    let (g, _) = crease::io::read(
-        abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_trimesh_001.obj"),
-        &Default::default(),
-    )
-    .unwrap();
-    let mesh = g.into_mesh().unwrap();
-    let pairs =
-        read_abc_sharp_edges(&abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_features_001.yml"))
-            .unwrap();
+    let (mesh, pairs) = common::abc_model(&dir);
     let em = EdgeMesh::new(&mesh).unwrap();
     let (truth, missing) = labels_from_pairs(&em.topo, &pairs);
     assert_eq!(missing, 0);

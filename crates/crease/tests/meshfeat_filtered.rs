@@ -30,6 +30,17 @@ fn classic(dir: &std::path::Path, file: &str) -> (TriMesh, Vec<bool>) {
     (mesh, truth)
 }
 
+/// The filtered dihedral angle with the default parameters.
+fn filtered(em: &EdgeMesh) -> Vec<f64> {
+    filtered_dihedral(
+        em,
+        FILTER_ITERATIONS,
+        &BilateralParams::default(),
+        &TvParams::default(),
+        &LineParams::default(),
+    )
+}
+
 fn with(method: EdgeMethod) -> EdgeParams {
     EdgeParams {
         method,
@@ -47,7 +58,6 @@ fn filtered_dihedral_beats_the_paper_estimators_on_noisy_classic_meshes() {
     let Some(dir) = common::data_dir() else {
         return;
     };
-    let bp = BilateralParams::default();
     for (file, noisy_min) in [
         ("fandisk.off", 0.98),
         ("cup.off", 0.965),
@@ -58,32 +68,14 @@ fn filtered_dihedral_beats_the_paper_estimators_on_noisy_classic_meshes() {
     ] {
         let (mesh, truth) = classic(&dir, file);
         let em = EdgeMesh::new(&mesh).unwrap();
-        let clean = auc(
-            &filtered_dihedral(
-                &em,
-                FILTER_ITERATIONS,
-                &bp,
-                &TvParams::default(),
-                &LineParams::default(),
-            ),
-            &truth,
-        );
+        let clean = auc(&filtered(&em), &truth);
         assert!(clean > 0.999, "{file} clean: AUC {clean}");
         if noisy_min == 0.0 {
             continue;
         }
         let noisy = add_noise(&mesh, 0.005, 7).unwrap();
         let em = EdgeMesh::new(&noisy).unwrap();
-        let f = auc(
-            &filtered_dihedral(
-                &em,
-                FILTER_ITERATIONS,
-                &bp,
-                &TvParams::default(),
-                &LineParams::default(),
-            ),
-            &truth,
-        );
+        let f = auc(&filtered(&em), &truth);
         let tan = mean_tangent_angle(&tangent_angles(&em, &EdgeParams::default().tangent).unwrap());
         let (t, d) = (auc(&tan, &truth), auc(&em.dihedral, &truth));
         eprintln!("{file}: noisy AUC filtered {f:.4} tangent {t:.4} dihedral {d:.4}");
@@ -103,7 +95,6 @@ fn filtered_dihedral_is_above_99_percent_at_the_papers_noise() {
     let Some(dir) = common::data_dir() else {
         return;
     };
-    let bp = BilateralParams::default();
     for (file, min) in [
         ("fandisk.off", 0.995),
         ("cup.off", 0.99),
@@ -135,14 +126,7 @@ fn filtered_dihedral_is_above_99_percent_at_the_papers_noise() {
             .collect();
         let noisy = add_noise(&mesh, 0.002, 7).unwrap();
         let em = EdgeMesh::new(&noisy).unwrap();
-        let filtered = filtered_dihedral(
-            &em,
-            FILTER_ITERATIONS,
-            &bp,
-            &TvParams::default(),
-            &LineParams::default(),
-        );
-        let f = auc(&pick(&filtered), &kept_truth);
+        let f = auc(&pick(&filtered(&em)), &kept_truth);
         let d = auc(&pick(&em.dihedral), &kept_truth);
         let left_out = keep.iter().filter(|&&k| !k).count();
         eprintln!("{file}: AUC at 0.2 % noise filtered {f:.4} dihedral {d:.4} ({left_out} sliver edges not scored)");
@@ -284,17 +268,7 @@ fn total_variation_keeps_noisy_creases_one_edge_wide() {
     let Some(dir) = common::data_dir() else {
         return;
     };
-    let abc = dir.join("abc");
-    let (g, _) = crease::io::read(
-        abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_trimesh_001.obj"),
-        &Default::default(),
-    )
-    .unwrap();
-    let abc_mesh = g.into_mesh().unwrap();
-    let pairs = crease::meshfeat::read_abc_sharp_edges(
-        &abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_features_001.yml"),
-    )
-    .unwrap();
+    let (abc_mesh, pairs) = common::abc_model(&dir);
     let (abc_truth, missing) = labels_from_pairs(&EdgeMesh::new(&abc_mesh).unwrap().topo, &pairs);
     assert_eq!(missing, 0);
     let bilateral_only = TvParams {
@@ -308,27 +282,17 @@ fn total_variation_keeps_noisy_creases_one_edge_wide() {
     ] {
         let noisy = add_noise(&mesh, 0.005, 7).unwrap();
         let em = EdgeMesh::new(&noisy).unwrap();
-        let bp = BilateralParams::default();
         let before = auc(
             &filtered_dihedral(
                 &em,
                 FILTER_ITERATIONS,
-                &bp,
+                &BilateralParams::default(),
                 &bilateral_only,
                 &LineParams::default(),
             ),
             &truth,
         );
-        let after = auc(
-            &filtered_dihedral(
-                &em,
-                FILTER_ITERATIONS,
-                &bp,
-                &TvParams::default(),
-                &LineParams::default(),
-            ),
-            &truth,
-        );
+        let after = auc(&filtered(&em), &truth);
         let fused = auc(
             &detect_prepared(&em, &with(EdgeMethod::Fused))
                 .unwrap()

@@ -169,21 +169,13 @@ pub fn dihedral_of(em: &EdgeMesh, n: &[Point3]) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::meshfeat::add_noise;
-    use crate::synth::{mesh as synth_mesh, MeshParams, Shape};
+    use crate::meshfeat::test_support::{cube, median, median_degrees};
 
     /// On a noisy cube the filtered normals of the faces away from the edges return to the
     /// face planes' normals, and the dihedral angle at the cube's edges stays near 90°.
     #[test]
     fn filtering_restores_the_planes_of_a_noisy_cube() {
-        let shape = Shape::from_name("cube").expect("shape");
-        let m = synth_mesh(
-            &shape,
-            &MeshParams {
-                target_edge: Some(shape.aabb().max_side() / 40.0),
-                ..Default::default()
-            },
-        )
-        .expect("mesh");
+        let m = cube(40.0);
         let noisy = add_noise(&m.mesh, 0.003, 3).expect("noise");
         let em = EdgeMesh::new(&noisy).expect("topology");
         let (truth, _) = crate::meshfeat::labels_from_pairs(&em.topo, &m.sharp_edges);
@@ -194,12 +186,8 @@ mod tests {
             let m = n.iter().fold(0.0f64, |a, c| a.max(c.abs()));
             m.clamp(-1.0, 1.0).acos().to_degrees()
         };
-        let median = |v: &mut Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v[v.len() / 2]
-        };
-        let before = median(&mut em.normals.iter().map(axis_err).collect());
-        let after = median(&mut filtered[1].iter().map(axis_err).collect());
+        let before = median(em.normals.iter().map(axis_err).collect());
+        let after = median(filtered[1].iter().map(axis_err).collect());
         assert!(
             before > 8.0,
             "noise: median normal error {before:.1} degrees"
@@ -209,15 +197,8 @@ mod tests {
             "filtered: {after:.1} vs {before:.1} degrees"
         );
         let d = dihedral_of(&em, &filtered[1]);
-        let mut on: Vec<f64> = (0..d.len())
-            .filter(|&e| truth[e])
-            .map(|e| d[e].to_degrees())
-            .collect();
-        let mut off: Vec<f64> = (0..d.len())
-            .filter(|&e| !truth[e])
-            .map(|e| d[e].to_degrees())
-            .collect();
-        let (on, off) = (median(&mut on), median(&mut off));
+        let on = median_degrees(&d, |e| truth[e]);
+        let off = median_degrees(&d, |e| !truth[e]);
         assert!(on > 60.0, "median filtered dihedral at the edges {on:.1}");
         assert!(off < 5.0, "median filtered dihedral elsewhere {off:.1}");
     }

@@ -114,24 +114,26 @@ pub fn smooth_along_lines(em: &EdgeMesh, score: &[f64], params: &LineParams) -> 
     }
     let min_cos = params.max_turn_degrees.to_radians().cos();
     let edges = em.topo.edges();
+    // The continuation of every edge at each of its two ends, once: the walks below only
+    // look them up.
+    let next: Vec<[Option<(usize, u32)>; 2]> = (0..edges.len())
+        .into_par_iter()
+        .map(|e| edges[e].map(|v| continuation(em, e, v, min_cos)))
+        .collect();
     let beta = params.weight;
     (0..edges.len())
         .into_par_iter()
         .map(|e| {
             let mut sum = score[e];
             let mut n = 1.0;
-            for start in edges[e] {
-                let (mut cur, mut v) = (e, start);
+            for start in next[e] {
+                let mut step = start;
                 for _ in 0..params.steps {
-                    match continuation(em, cur, v, min_cos) {
-                        Some((next, w)) => {
-                            sum += score[next];
-                            n += 1.0;
-                            cur = next;
-                            v = w;
-                        }
-                        None => break,
-                    }
+                    let Some((cur, far)) = step else { break };
+                    sum += score[cur];
+                    n += 1.0;
+                    let [a, _] = edges[cur];
+                    step = next[cur][usize::from(a != far)];
                 }
             }
             (1.0 - beta) * score[e] + beta * sum / n
@@ -142,22 +144,14 @@ pub fn smooth_along_lines(em: &EdgeMesh, score: &[f64], params: &LineParams) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::{mesh as synth_mesh, MeshParams, Shape};
+    use crate::meshfeat::test_support::cube;
 
     /// On a cube's mesh, a score of 1 on one edge of each straight line segment and 0 elsewhere
     /// spreads only along the lines it lies on: the edges walked along a cube edge are cube
     /// edges, so an indicator of the cube's edges is unchanged.
     #[test]
     fn smoothing_follows_straight_lines() {
-        let shape = Shape::from_name("cube").expect("shape");
-        let m = synth_mesh(
-            &shape,
-            &MeshParams {
-                target_edge: Some(shape.aabb().max_side() / 20.0),
-                ..Default::default()
-            },
-        )
-        .expect("mesh");
+        let m = cube(20.0);
         let em = EdgeMesh::new(&m.mesh).expect("topology");
         let (truth, _) = crate::meshfeat::labels_from_pairs(&em.topo, &m.sharp_edges);
         let indicator: Vec<f64> = truth.iter().map(|&t| f64::from(u8::from(t))).collect();

@@ -47,6 +47,41 @@ pub mod train;
 pub mod truth;
 pub mod tv;
 
+/// Shared fixtures of the unit tests of the meshfeat modules.
+#[cfg(test)]
+pub(crate) mod test_support {
+    use crate::synth::{mesh as synth_mesh, MeshParams, Shape, SyntheticMesh};
+
+    /// The unit cube meshed with edges of 1 / `per_side` of its side, with exact sharp edges.
+    pub fn cube(per_side: f64) -> SyntheticMesh {
+        let shape = Shape::from_name("cube").expect("shape");
+        synth_mesh(
+            &shape,
+            &MeshParams {
+                target_edge: Some(shape.aabb().max_side() / per_side),
+                ..Default::default()
+            },
+        )
+        .expect("mesh")
+    }
+
+    /// The median of `v` (the upper one for an even count).
+    pub fn median(mut v: Vec<f64>) -> f64 {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    }
+
+    /// The median, in degrees, of the angles (radians) of the edges where `pick` holds.
+    pub fn median_degrees(angles: &[f64], pick: impl Fn(usize) -> bool) -> f64 {
+        median(
+            (0..angles.len())
+                .filter(|&e| pick(e))
+                .map(|e| angles[e].to_degrees())
+                .collect(),
+        )
+    }
+}
+
 use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::Instant;

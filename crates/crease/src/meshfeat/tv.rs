@@ -139,49 +139,22 @@ pub fn tv_normals(em: &EdgeMesh, init: &[Point3], params: &TvParams) -> Vec<Poin
 mod tests {
     use super::*;
     use crate::meshfeat::bilateral::dihedral_of;
+    use crate::meshfeat::test_support::{cube, median_degrees};
     use crate::meshfeat::{add_noise, labels_from_pairs};
-    use crate::synth::{mesh as synth_mesh, MeshParams, Shape};
 
     /// On a noisy cube the total-variation normals are flat on the faces and the dihedral
     /// angle stays near 90° on the cube's edges: the jump is kept on the edge itself.
     #[test]
     fn total_variation_keeps_the_cube_edges_one_edge_wide() {
-        let shape = Shape::from_name("cube").expect("shape");
-        let m = synth_mesh(
-            &shape,
-            &MeshParams {
-                target_edge: Some(shape.aabb().max_side() / 40.0),
-                ..Default::default()
-            },
-        )
-        .expect("mesh");
+        let m = cube(40.0);
         let noisy = add_noise(&m.mesh, 0.005, 3).expect("noise");
         let em = EdgeMesh::new(&noisy).expect("topology");
         let (truth, _) = labels_from_pairs(&em.topo, &m.sharp_edges);
         let n = tv_normals(&em, &em.normals, &TvParams::default());
         let d = dihedral_of(&em, &n);
-        let median = |mut v: Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v[v.len() / 2]
-        };
-        let raw_off = median(
-            (0..d.len())
-                .filter(|&e| !truth[e])
-                .map(|e| em.dihedral[e].to_degrees())
-                .collect(),
-        );
-        let on = median(
-            (0..d.len())
-                .filter(|&e| truth[e])
-                .map(|e| d[e].to_degrees())
-                .collect(),
-        );
-        let off = median(
-            (0..d.len())
-                .filter(|&e| !truth[e])
-                .map(|e| d[e].to_degrees())
-                .collect(),
-        );
+        let raw_off = median_degrees(&em.dihedral, |e| !truth[e]);
+        let on = median_degrees(&d, |e| truth[e]);
+        let off = median_degrees(&d, |e| !truth[e]);
         assert!(raw_off > 15.0, "noise: median raw angle {raw_off:.1}");
         assert!(on > 60.0, "median angle on the edges {on:.1}");
         assert!(off < 3.0, "median angle elsewhere {off:.1}");

@@ -44,3 +44,19 @@ pub fn noisy_part(name: &str, n: usize, noise: f64) -> crease::synth::SyntheticP
     )
     .expect("sampling works")
 }
+
+/// The ABC model of `dir/abc` (`dir` = [`data_dir`]): its mesh and the vertex pairs of its
+/// sharp feature curves (`crease::meshfeat::read_abc_sharp_edges`).
+pub fn abc_model(dir: &std::path::Path) -> (crease::geometry::TriMesh, Vec<[u32; 2]>) {
+    let abc = dir.join("abc");
+    let (g, _) = crease::io::read(
+        abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_trimesh_001.obj"),
+        &Default::default(),
+    )
+    .expect("ABC mesh");
+    let pairs = crease::meshfeat::read_abc_sharp_edges(
+        &abc.join("00000006_d4fe04f0f5f84b52bd4f10e4_features_001.yml"),
+    )
+    .expect("ABC features");
+    (g.into_mesh().expect("ABC faces"), pairs)
+}
