@@ -304,3 +304,54 @@ fn total_variation_keeps_noisy_creases_one_edge_wide() {
         assert!(fused > fused_min, "{name}: fused {fused}");
     }
 }
+
+/// Every method gives the same labels and the same sharpness whatever the mesh's units: a
+/// noisy part scaled by 1000 and by 1/1000 (millimetres to micrometres or metres). The total
+/// variation's data term depended on the units until it was divided by the mean face area.
+#[test]
+fn every_method_is_independent_of_the_mesh_units() {
+    let shape = Shape::from_name("fillet-chamfer-cone").unwrap();
+    let m = synth_mesh(
+        &shape,
+        &MeshParams {
+            target_edge: Some(shape.aabb().max_side() / 30.0),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let noisy = add_noise(&m.mesh, 0.005, 5).unwrap();
+    let scaled = |k: f64| {
+        let p: Vec<[f64; 3]> = noisy
+            .positions()
+            .iter()
+            .map(|q| [q[0] * k, q[1] * k, q[2] * k])
+            .collect();
+        TriMesh::new(p, noisy.faces.clone()).unwrap()
+    };
+    let em = EdgeMesh::new(&noisy).unwrap();
+    for method in EdgeMethod::ALL {
+        let reference = detect_prepared(&em, &with(method)).unwrap();
+        assert!(reference.sharp.iter().any(|&s| s), "{}", method.name());
+        for k in [1e3, 1e-3] {
+            let mesh = scaled(k);
+            let other = detect_prepared(&EdgeMesh::new(&mesh).unwrap(), &with(method)).unwrap();
+            let differ = reference
+                .sharp
+                .iter()
+                .zip(&other.sharp)
+                .filter(|(a, b)| a != b)
+                .count();
+            let worst = reference
+                .sharpness
+                .iter()
+                .zip(&other.sharpness)
+                .map(|(a, b)| (a - b).abs() / a.abs().max(1.0))
+                .fold(0.0, f64::max);
+            assert!(
+                differ == 0 && worst < 1e-6,
+                "{} at scale {k}: {differ} labels differ, sharpness off by {worst:e}",
+                method.name()
+            );
+        }
+    }
+}
