@@ -71,7 +71,7 @@ pub enum Command {
     /// scores, ROC and AUC.
     Eval(crate::commands::eval::EvalArgs),
     /// Feature edges of a triangle mesh that survive noise (the learned classifier fused with
-    /// filtered normals by default; tangent-plane angle, Potts energy minimised by
+    /// filtered normals and fitted surfaces by default; tangent-plane angle, Potts energy minimised by
     /// a graph cut; dihedral and hysteresis thresholding as baselines).
     Edges(crate::commands::edges::EdgesArgs),
     /// Train the learned edge classifier (RBF SVM) on meshes with ground truth.

@@ -21,8 +21,8 @@ use std::path::{Path, PathBuf};
 use crease::geometry::TriMesh;
 use crease::meshfeat::{
     add_noise, classic_label_degrees, default_model, dihedral_labels, feature_polylines,
-    filtered_dihedral, fused_scores, hysteresis_scores, learned_scores, potts_labels, EdgeMesh,
-    EdgePairs, EdgeParams, PottsParams,
+    filtered_dihedral, fused_scores, hysteresis_scores, intersection_scores, learned_scores,
+    potts_labels, EdgeMesh, EdgePairs, EdgeParams, PottsParams,
 };
 use crease::render::{Polyline, RenderParams, Scene, View, ViewLayout};
 
@@ -103,13 +103,9 @@ fn main() {
     let filtered = filtered_dihedral(&em, d.filter_iterations, &d.bilateral, &d.tv, &d.line);
     let hyst = hysteresis_scores(&em, &em.dihedral, d.low_ratio).expect("hysteresis");
     let (decision, _) = learned_scores(&em, default_model()).expect("SVM");
-    let fused = fused_scores(
-        &decision,
-        &filtered,
-        0.0,
-        d.filtered_degrees,
-        d.fused_svm_weight,
-    );
+    let intersection =
+        intersection_scores(&em, &d.intersection, d.filtered_degrees).expect("segmentation");
+    let fused = fused_scores(&decision, &filtered, Some(&intersection), &d);
     let fpr = 1e-4;
     // potts-filtered: the decision angle θ_true swept over 1..90°, the labelling with the most
     // true edges among those with at most 1e-4 false ones.

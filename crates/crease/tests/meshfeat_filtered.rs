@@ -10,8 +10,8 @@ use crease::eval::Confusion;
 use crease::geometry::TriMesh;
 use crease::meshfeat::{
     add_noise, classic_label_degrees, detect_prepared, dihedral_labels, filtered_dihedral,
-    labels_from_pairs, mean_tangent_angle, sliver_edges, tangent_angles, BilateralParams, EdgeMesh,
-    EdgeMethod, EdgeParams, LineParams, TvParams, FILTER_ITERATIONS,
+    intersection_scores, labels_from_pairs, mean_tangent_angle, sliver_edges, tangent_angles,
+    BilateralParams, EdgeMesh, EdgeMethod, EdgeParams, LineParams, TvParams, FILTER_ITERATIONS,
 };
 use crease::synth::{mesh as synth_mesh, MeshParams, Shape};
 
@@ -212,8 +212,8 @@ fn filtered_labels_a_noisy_part_and_keeps_a_noisy_grid_clean() {
 
 /// `fused` (the default) at the paper's noise (0.2 % of the largest side) on the classic
 /// meshes: above both of its parts on the mean, and above 99 % AUC on the meshes without
-/// slivers. Measured (shipped model): fandisk 99.91 %, cup 99.70, bar 99.90, block 98.17,
-/// sharp_sphere 99.25; filtered 99.94, 99.67, 99.91, 97.52, 98.87; learned 96.57, 93.06,
+/// slivers. Measured (shipped model): fandisk 99.93 %, cup 99.79, bar 99.90, block 98.20,
+/// sharp_sphere 99.26; filtered 99.94, 99.67, 99.91, 97.52, 98.87; learned 96.57, 93.06,
 /// 99.20, 95.13, 97.64.
 #[test]
 fn fused_beats_filtered_and_learned_at_the_papers_noise() {
@@ -262,7 +262,7 @@ fn fused_beats_filtered_and_learned_at_the_papers_noise() {
 /// filtering alone spreads them over the neighbouring edges: the filtered angle with its
 /// total-variation half scores above the bilateral angle alone, and `fused` above 98 % AUC.
 /// Measured (both smoothed along the lines): fandisk bilateral 97.01 % → filtered 98.77 %,
-/// fused 98.42 %; ABC 93.99 % → 99.06 %, fused 98.86 %.
+/// fused 98.53 %; ABC 93.99 % → 99.04 %, fused 98.76 %.
 #[test]
 fn total_variation_keeps_noisy_creases_one_edge_wide() {
     let Some(dir) = common::data_dir() else {
@@ -308,6 +308,8 @@ fn total_variation_keeps_noisy_creases_one_edge_wide() {
 /// Every method gives the same labels and the same sharpness whatever the mesh's units: a
 /// noisy part scaled by 1000 and by 1/1000 (millimetres to micrometres or metres). The total
 /// variation's data term depended on the units until it was divided by the mean face area.
+/// Measured: `fused` 0 labels differ, sharpness within 3e-6 (the segmentation's fits); every
+/// other method within 1e-6.
 #[test]
 fn every_method_is_independent_of_the_mesh_units() {
     let shape = Shape::from_name("fillet-chamfer-cone").unwrap();
@@ -347,11 +349,52 @@ fn every_method_is_independent_of_the_mesh_units() {
                 .zip(&other.sharpness)
                 .map(|(a, b)| (a - b).abs() / a.abs().max(1.0))
                 .fold(0.0, f64::max);
+            // `fused` reads the surfaces of the segmentation, whose iterative fits stop at a
+            // relative step of about 1e-7: their round-off moves its score by a few 1e-6.
+            let tol = if method == EdgeMethod::Fused {
+                1e-5
+            } else {
+                1e-6
+            };
             assert!(
-                differ == 0 && worst < 1e-6,
+                differ == 0 && worst < tol,
                 "{} at scale {k}: {differ} labels differ, sharpness off by {worst:e}",
                 method.name()
             );
         }
+    }
+}
+
+/// The surface-intersection term of `fused` (`meshfeat::surfaces`) at the 0.5 % noise of our
+/// protocol: on cup.off, whose shallow creases and coarse toroidal facets local estimators
+/// cannot tell apart, the fitted surfaces' intersections rank the edges better than anything
+/// local and lift `fused`; on fandisk it costs nothing. Measured (seed 7): cup intersections
+/// alone 99.02 %, fused 97.16 % → 98.69 %; fandisk 98.42 % → 98.53 %.
+#[test]
+fn surface_intersections_lift_fused_on_the_coarse_cup() {
+    let Some(dir) = common::data_dir() else {
+        return;
+    };
+    for (file, alone_min, gain) in [("cup.off", 0.98, 0.01), ("fandisk.off", 0.8, 0.0)] {
+        let (mesh, truth) = classic(&dir, file);
+        let noisy = add_noise(&mesh, 0.005, 7).unwrap();
+        let em = EdgeMesh::new(&noisy).unwrap();
+        let params = EdgeParams::default();
+        let alone = auc(
+            &intersection_scores(&em, &params.intersection, params.filtered_degrees).unwrap(),
+            &truth,
+        );
+        let with_term = auc(&detect_prepared(&em, &params).unwrap().sharpness, &truth);
+        let mut without = params.clone();
+        without.intersection.weight = 0.0;
+        let without = auc(&detect_prepared(&em, &without).unwrap().sharpness, &truth);
+        eprintln!(
+            "{file} at 0.5 % noise: intersections {alone:.4}, fused {without:.4} -> {with_term:.4}"
+        );
+        assert!(alone > alone_min, "{file}: intersections alone {alone}");
+        assert!(
+            with_term > without + gain,
+            "{file}: fused {without} -> {with_term}"
+        );
     }
 }

@@ -75,8 +75,9 @@ pub enum MethodArg {
     Filtered,
     /// Potts energy with the filtered dihedral angle as data term.
     PottsFiltered,
-    /// The SVM decision value and the filtered dihedral angle combined (0.1 d + 0.9 (θ / 25° − 1)
-    /// above 0): the most accurate on clean and noisy meshes.
+    /// The SVM decision value, the filtered dihedral angle and the intersections of the
+    /// segmentation's fitted surfaces combined (0.1 d + 0.9 (θ / 25° − 1) + 0.3 s above 0): the
+    /// most accurate on clean and noisy meshes.
     Fused,
 }
 
@@ -207,6 +208,7 @@ pub fn run(g: &Global, a: &EdgesArgs) -> anyhow::Result<()> {
             "filter_iterations": params.filter_iterations,
             "total_variation": params.tv,
             "line_smoothing": params.line,
+            "surface_intersection": params.intersection,
             "tangent_scales": params.tangent.scales,
             "potts": params.potts,
             "model": a.model,

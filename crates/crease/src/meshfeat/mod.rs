@@ -33,7 +33,9 @@
 //!   classifier (noisy mean 95.02 % shipped, 94.94 % leave-one-out), nor did the point-cloud
 //!   sharp stage's sharpness at the vertices (94.69 % / 95.53 %);
 //! * `fused` (the default, crease's addition): the SVM decision value and the filtered angle
-//!   combined ([`fused_scores`]), better than either on every noise level measured.
+//!   combined ([`fused_scores`]), better than either on every noise level measured, plus the
+//!   evidence of [`surfaces`]: where the analytic surfaces fitted by the segmentation
+//!   (mizoguchi, [`crate::segment`]) intersect.
 
 pub mod baseline;
 pub mod bilateral;
@@ -41,6 +43,7 @@ pub mod features;
 mod grid;
 pub mod line;
 pub mod potts;
+pub mod surfaces;
 pub mod svm;
 pub mod tangent;
 pub mod train;
@@ -94,6 +97,7 @@ pub use bilateral::BilateralParams;
 pub use features::{edge_features, EdgeFeatures, FeatureParams, NUM_FEATURES};
 pub use line::LineParams;
 pub use potts::{potts_labels, potts_labels_unary, svm_unary, EdgePairs, PottsParams};
+pub use surfaces::{intersection_scores, IntersectionParams};
 pub use svm::{default_model, SvmModel, TrainParams, TrainingSet};
 pub use tangent::{accept_angle, tangent_angles, TangentAngles, TangentParams, PAPER_SCALES};
 pub use train::{synthetic_meshes, training_set, LabelledMesh, SetParams};
@@ -297,8 +301,9 @@ pub enum EdgeMethod {
     /// Equation 1 with the data term of equation 5 on the filtered dihedral angle (its
     /// decision angle θ_true = [`EdgeParams::filtered_degrees`]).
     PottsFiltered,
-    /// crease's fusion of the paper's learned classifier and the filtered dihedral angle
-    /// ([`fused_scores`]): w · d(e) + (1 − w) · (θ_f(e) / θ_t − 1) above 0.
+    /// crease's fusion of the paper's learned classifier, the filtered dihedral angle and the
+    /// intersections of fitted surfaces ([`fused_scores`]): w · d(e) + (1 − w) · (θ_f(e) /
+    /// θ_t − 1) + β · s(e) above 0.
     Fused,
 }
 
@@ -359,12 +364,12 @@ impl EdgeMethod {
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeParams {
     /// The method (default `fused`: the most accurate crease has on the 11 meshes of Table 2,
-    /// mean AUC 100.00 % clean, 99.71 % at noise 0.2 % of the largest side and 98.86 % at
+    /// mean AUC 100.00 % clean, 99.73 % at noise 0.2 % of the largest side and 99.02 % at
     /// 0.5 %, against 100.00 / 99.62 / 98.80 % for `filtered`, 98.61 / 98.20 / 95.07 % for
     /// `learned` with the shipped model, 98.23 / 97.43 / 93.48 % for the tangent-plane angle and
     /// 100 / 97.18 / 80.43 % for dihedral thresholding; measured with
-    /// `examples/meshfeat_table2.rs` and `examples/meshfeat_learned.rs`). `filtered` is 10
-    /// times faster (1.4 s against 14.4 s at 1M edges) and nearly as accurate.
+    /// `examples/meshfeat_table2.rs` and `examples/meshfeat_learned.rs`). `filtered` is 20
+    /// times faster (1.4 s against 24–27 s at 1M edges) and nearly as accurate.
     pub method: EdgeMethod,
     /// Threshold of `dihedral` / `tangent` and high threshold of `hysteresis`, degrees
     /// (default 65: where θ̂ʳ gives the best F1 on the noisy synthetic parts; on clean meshes
@@ -398,6 +403,8 @@ pub struct EdgeParams {
     pub filtered_degrees: f64,
     /// Weight w of the SVM decision value in `fused` (default [`FUSED_SVM_WEIGHT`]).
     pub fused_svm_weight: f64,
+    /// The surface-intersection term of `fused` ([`surfaces`]).
+    pub intersection: IntersectionParams,
 }
 
 /// Default weight of the SVM in the `fused` score ([`fused_scores`]).
@@ -455,6 +462,7 @@ impl Default for EdgeParams {
             line: LineParams::default(),
             filtered_degrees: FILTERED_DEGREES,
             fused_svm_weight: FUSED_SVM_WEIGHT,
+            intersection: IntersectionParams::default(),
         }
     }
 }
@@ -469,6 +477,8 @@ pub struct EdgeTimings {
     pub tangent: f64,
     /// SVM decision values (0 if not used).
     pub classify: f64,
+    /// The segmentation and surface-intersection scores of `fused` (0 if not used).
+    pub surfaces: f64,
     /// Labelling (threshold, hysteresis or graph cut).
     pub label: f64,
 }
@@ -720,6 +730,20 @@ fn detect_learned(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetection> {
                 params.fused_svm_weight
             )));
         }
+        let ip = &params.intersection;
+        let valid = ip.weight.is_finite()
+            && ip.weight >= 0.0
+            && ip.width.is_finite()
+            && ip.width > 0.0
+            && ip.noise_floor.is_finite()
+            && ip.noise_floor >= 0.0
+            && ip.max_points > 0;
+        if !valid {
+            return Err(Error::InvalidArgument(format!(
+                "feature edges: the surface-intersection term of `fused` needs a finite weight \
+                 >= 0, a width > 0, a noise floor >= 0 and max_points >= 1, got {ip:?}"
+            )));
+        }
         let t0 = Instant::now();
         let filtered = filtered_dihedral(
             em,
@@ -729,14 +753,19 @@ fn detect_learned(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetection> {
             &params.line,
         );
         timings.tangent += t0.elapsed().as_secs_f64();
+        let t2 = Instant::now();
+        let intersection = if params.intersection.weight > 0.0 {
+            Some(intersection_scores(
+                em,
+                &params.intersection,
+                params.filtered_degrees,
+            )?)
+        } else {
+            None
+        };
+        timings.surfaces = t2.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        let score = fused_scores(
-            &d,
-            &filtered,
-            params.decision_bias,
-            params.filtered_degrees,
-            params.fused_svm_weight,
-        );
+        let score = fused_scores(&d, &filtered, intersection.as_deref(), params);
         let sharp = threshold(&score, 0.0);
         timings.label = t1.elapsed().as_secs_f64();
         return Ok(EdgeDetection {
@@ -763,10 +792,16 @@ fn detect_learned(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetection> {
 }
 
 /// The `fused` score of every edge (crease's addition): w · (d(e) + bias) + (1 − w) ·
-/// (θ_f(e) / θ_t − 1), with d the SVM decision value of section 6.3 (0 on its decision
-/// boundary), θ_f the filtered dihedral angle ([`filtered_dihedral`], radians) and θ_t the
-/// filtered threshold in degrees (so that both terms are 0 at their own decision point and
-/// the edge is a feature edge above 0).
+/// (θ_f(e) / θ_t − 1) + β · s(e), with d the SVM decision value of section 6.3 (0 on its
+/// decision boundary), θ_f the filtered dihedral angle ([`filtered_dihedral`], radians), θ_t
+/// the filtered threshold in degrees (so that both terms are 0 at their own decision point and
+/// the edge is a feature edge above 0), s ∈ [0, 1] the surface-intersection score of
+/// [`surfaces::intersection_scores`] (`intersection`; `None` = 0) and β its weight
+/// ([`IntersectionParams::weight`], default 0.3), all from `params`.
+///
+/// **The intersection term** (added 2026-12-04, see [`surfaces`] for its measurements): mean
+/// AUC over the 11 meshes 100.00 / 99.71 / 98.86 % → 100.00 / 99.73 / 99.02 % (clean / 0.2 % /
+/// 0.5 %), 99.56 → 99.62 % at 0.289 %; the table below was measured without it.
 ///
 /// **Why.** The two estimators fail on different meshes. The SVM, trained on synthetic parts
 /// only, reads the 43 multi-scale features of section 4 and handles coarse CAD tessellations
@@ -795,15 +830,20 @@ fn detect_learned(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetection> {
 pub fn fused_scores(
     decision: &[f64],
     filtered: &[f64],
-    bias: f64,
-    filtered_degrees: f64,
-    svm_weight: f64,
+    intersection: Option<&[f64]>,
+    params: &EdgeParams,
 ) -> Vec<f64> {
-    let inv_t = 1.0 / filtered_degrees.to_radians();
+    let inv_t = 1.0 / params.filtered_degrees.to_radians();
+    let (w, bias) = (params.fused_svm_weight, params.decision_bias);
+    let beta = params.intersection.weight;
     decision
         .par_iter()
         .zip(filtered.par_iter())
-        .map(|(&d, &f)| svm_weight * (d + bias) + (1.0 - svm_weight) * (f * inv_t - 1.0))
+        .enumerate()
+        .map(|(e, (&d, &f))| {
+            let s = intersection.map_or(0.0, |s| beta * s[e]);
+            w * (d + bias) + (1.0 - w) * (f * inv_t - 1.0) + s
+        })
         .collect()
 }
 
