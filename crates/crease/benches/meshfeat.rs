@@ -1,5 +1,6 @@
 //! Mesh feature-edge benchmarks (vidal et al. 2011): the default `fused` method (the learned
-//! pipeline and the filtered angle), `filtered` (bilateral and total-variation normal filtering,
+//! pipeline, the filtered angle and the surface-intersection term, whose segmentation
+//! dominates from 2026-12-04), `filtered` (bilateral and total-variation normal filtering,
 //! the mean of their dihedral angles smoothed along the lines), the learned pipeline (the 43 features of
 //! section 4, then the shipped SVM's decision values) and the tangent-plane method,
 //! on the synthetic fillet-chamfer-cone part meshed with about 10k and 100k edges (and 1M

@@ -213,7 +213,7 @@ fn filtered_labels_a_noisy_part_and_keeps_a_noisy_grid_clean() {
 /// `fused` (the default) at the paper's noise (0.2 % of the largest side) on the classic
 /// meshes: above both of its parts on the mean, and above 99 % AUC on the meshes without
 /// slivers. Measured (shipped model): fandisk 99.93 %, cup 99.79, bar 99.90, block 98.20,
-/// sharp_sphere 99.26; filtered 99.94, 99.67, 99.91, 97.52, 98.87; learned 96.57, 93.06,
+/// sharp_sphere 99.33; filtered 99.94, 99.67, 99.91, 97.52, 98.87; learned 96.57, 93.06,
 /// 99.20, 95.13, 97.64.
 #[test]
 fn fused_beats_filtered_and_learned_at_the_papers_noise() {
@@ -262,7 +262,7 @@ fn fused_beats_filtered_and_learned_at_the_papers_noise() {
 /// filtering alone spreads them over the neighbouring edges: the filtered angle with its
 /// total-variation half scores above the bilateral angle alone, and `fused` above 98 % AUC.
 /// Measured (both smoothed along the lines): fandisk bilateral 97.01 % → filtered 98.77 %,
-/// fused 98.53 %; ABC 93.99 % → 99.04 %, fused 98.76 %.
+/// fused 98.54 %; ABC 93.99 % → 99.04 %, fused 98.75 %.
 #[test]
 fn total_variation_keeps_noisy_creases_one_edge_wide() {
     let Some(dir) = common::data_dir() else {
@@ -369,7 +369,7 @@ fn every_method_is_independent_of_the_mesh_units() {
 /// protocol: on cup.off, whose shallow creases and coarse toroidal facets local estimators
 /// cannot tell apart, the fitted surfaces' intersections rank the edges better than anything
 /// local and lift `fused`; on fandisk it costs nothing. Measured (seed 7): cup intersections
-/// alone 99.02 %, fused 97.16 % → 98.69 %; fandisk 98.42 % → 98.53 %.
+/// alone 99.22 %, fused 97.16 % → 98.71 %; fandisk alone 83.74 %, fused 98.42 % → 98.54 %.
 #[test]
 fn surface_intersections_lift_fused_on_the_coarse_cup() {
     let Some(dir) = common::data_dir() else {

@@ -364,7 +364,7 @@ impl EdgeMethod {
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeParams {
     /// The method (default `fused`: the most accurate crease has on the 11 meshes of Table 2,
-    /// mean AUC 100.00 % clean, 99.73 % at noise 0.2 % of the largest side and 99.02 % at
+    /// mean AUC 100.00 % clean, 99.74 % at noise 0.2 % of the largest side and 99.04 % at
     /// 0.5 %, against 100.00 / 99.62 / 98.80 % for `filtered`, 98.61 / 98.20 / 95.07 % for
     /// `learned` with the shipped model, 98.23 / 97.43 / 93.48 % for the tangent-plane angle and
     /// 100 / 97.18 / 80.43 % for dihedral thresholding; measured with
@@ -800,8 +800,8 @@ fn detect_learned(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetection> {
 /// ([`IntersectionParams::weight`], default 0.3), all from `params`.
 ///
 /// **The intersection term** (added 2026-12-04, see [`surfaces`] for its measurements): mean
-/// AUC over the 11 meshes 100.00 / 99.71 / 98.86 % → 100.00 / 99.73 / 99.02 % (clean / 0.2 % /
-/// 0.5 %), 99.56 → 99.62 % at 0.289 %; the table below was measured without it.
+/// AUC over the 11 meshes 100.00 / 99.71 / 98.86 % → 100.00 / 99.74 / 99.04 % (clean / 0.2 % /
+/// 0.5 %), 99.56 → 99.63 % at 0.289 %; the table below was measured without it.
 ///
 /// **Why.** The two estimators fail on different meshes. The SVM, trained on synthetic parts
 /// only, reads the 43 multi-scale features of section 4 and handles coarse CAD tessellations
