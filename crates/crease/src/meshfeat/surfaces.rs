@@ -59,9 +59,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::EdgeMesh;
-use crate::geometry::{vec3, Aabb, Point3};
+use crate::geometry::{vec3, Aabb, Csr, Point3};
 use crate::segment::fit::{signed_distance, surface_normal};
 use crate::segment::{segment_points, PointParams, SegmentParams};
+use crate::spatial::mesh_rings::vertex_k_rings;
 use crate::Result;
 
 /// Parameters of [`intersection_scores`] and of its weight in `fused`.
@@ -96,22 +97,12 @@ fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// The vertices (ids) of the faces around `v`, `v` included, each once.
-fn ring(em: &EdgeMesh, v: u32, out: &mut Vec<u32>) {
-    let faces = em.topo.faces();
-    for &f in em.topo.vertex_faces(v as usize) {
-        for &u in &faces[f as usize] {
-            if !out.contains(&u) {
-                out.push(u);
-            }
-        }
-    }
-}
-
 /// Per vertex, the id of its fitted surface (−1 for none), and the surfaces' parameters;
 /// `None` when too few vertices are on faces to segment.
+/// `rings`: the 2-ring of every vertex ([`vertex_k_rings`]).
 fn vertex_surfaces(
     em: &EdgeMesh,
+    rings: &Csr,
     params: &IntersectionParams,
 ) -> Result<Option<(Vec<i32>, Vec<crate::synth::SurfaceParams>)>> {
     let p = em.mesh.positions();
@@ -153,14 +144,10 @@ fn vertex_surfaces(
                 if is_sampled[v as usize] {
                     return label[v as usize];
                 }
-                let mut one = Vec::new();
-                ring(em, v, &mut one);
-                let mut two = one.clone();
-                for &u in &one {
-                    ring(em, u, &mut two);
-                }
                 let q = p[v as usize];
-                two.iter()
+                rings
+                    .row(v as usize)
+                    .iter()
                     .filter(|&&u| is_sampled[u as usize] && label[u as usize] >= 0)
                     .map(|&u| label[u as usize])
                     .map(|s| (signed_distance(&surfaces[s as usize], q).abs(), s))
@@ -181,7 +168,10 @@ pub fn intersection_scores(
     params: &IntersectionParams,
     decision_degrees: f64,
 ) -> Result<Vec<f64>> {
-    let Some((label, surfaces)) = vertex_surfaces(em, params)? else {
+    // Two rings: the crease vertices of a noisy cloud are often left to one surface, or to
+    // none, so the other surface's vertices can be a ring further.
+    let rings = vertex_k_rings(&em.topo, 2)?;
+    let Some((label, surfaces)) = vertex_surfaces(em, &rings, params)? else {
         return Ok(vec![0.0; em.num_edges()]);
     };
     let p = em.mesh.positions();
@@ -209,18 +199,13 @@ pub fn intersection_scores(
         .into_par_iter()
         .map(|e| {
             let [a, b] = edges[e];
-            let mut around = Vec::new();
-            ring(em, a, &mut around);
-            ring(em, b, &mut around);
-            // Two rings: the crease vertices of a noisy cloud are often left to one surface, or
-            // to none, so the other surface's vertices can be a ring further.
-            let first = around.clone();
-            for &u in &first {
-                ring(em, u, &mut around);
-            }
+            let around = [a, b].into_iter().chain(
+                (rings.row(a as usize).iter())
+                    .chain(rings.row(b as usize))
+                    .copied(),
+            );
             let mut ids: Vec<i32> = around
-                .iter()
-                .map(|&u| label[u as usize])
+                .map(|u| label[u as usize])
                 .filter(|&s| s >= 0)
                 .collect();
             ids.sort_unstable();
