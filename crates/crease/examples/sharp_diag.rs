@@ -6,9 +6,10 @@
 use std::path::PathBuf;
 
 use crease::eval::truth::{class_of_color, PointClass};
-use crease::geometry::{average_spacing, vec3, PointCloud};
+use crease::geometry::{vec3, PointCloud};
 use crease::io::{read, write, Geometry, ReadOptions, WriteOptions};
 use crease::sharp::{detect_points, SharpParams};
+use crease::spatial::average_spacing;
 use crease::spatial::knn;
 
 fn mcc(pred: &[bool], truth: &[bool]) -> f64 {

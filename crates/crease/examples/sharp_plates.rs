@@ -7,8 +7,9 @@
 use std::path::PathBuf;
 
 use crease::eval::truth::{class_of_color, PointClass};
-use crease::geometry::{average_spacing, vec3};
+use crease::geometry::vec3;
 use crease::io::{read, ReadOptions};
+use crease::spatial::average_spacing;
 use crease::spatial::knn;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -17,7 +17,7 @@ use std::time::Instant;
 use crease::meshfeat::features::feature_names;
 use crease::meshfeat::svm::train;
 use crease::meshfeat::train::f_scores;
-use crease::meshfeat::{synthetic_meshes, training_set, FeatureParams, SetParams, TrainParams};
+use crease::meshfeat::{training_set, FeatureParams, LabelledMesh, SetParams, TrainParams};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -42,7 +42,11 @@ fn main() {
         i += 2;
     }
     let t0 = Instant::now();
-    let meshes = synthetic_meshes(&per_side).expect("synthetic meshes");
+    let meshes: Vec<LabelledMesh> = crease::synth::training_meshes(&per_side)
+        .expect("synthetic meshes")
+        .into_iter()
+        .map(|(name, m)| LabelledMesh::from_pairs(name, m.mesh, &m.sharp_edges).expect("labels"))
+        .collect();
     let set = training_set(&meshes, &fp, &sp).expect("training set");
     let npos = set.y.iter().filter(|&&t| t).count();
     println!(

@@ -5,12 +5,11 @@ use crease::estimate::bezier::{bezier_curvature, bezier_curvature_single, Bezier
 use crease::estimate::curvature::{
     quadric_curvature, quadric_curvature_oriented, Curvature, QuadricParams,
 };
+use crease::geometry::SurfaceParams;
 use crease::geometry::{MeshTopology, Point3, TriMesh};
 use crease::spatial::knn;
 use crease::spatial::mesh_rings::vertex_k_rings;
-use crease::synth::{
-    self, MeshParams, Noise, NoiseScale, SampleParams, Shape, SurfaceParams, SyntheticPart,
-};
+use crease::synth::{self, MeshParams, Noise, NoiseScale, SampleParams, Shape, SyntheticPart};
 
 fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
     v.retain(|x| x.is_finite());

@@ -156,7 +156,7 @@ fn synthetic_cube_scored_against_its_own_perturbed_labels() {
     // Deterministic perturbation: every 4th sharp point missed, every 50th flat point far from
     // the edges (>= 5 spacings) wrongly marked.
     let dist = &cloud.attribute(attr::EDGE_DISTANCE).unwrap().values;
-    let spacing = crease::geometry::average_spacing(&cloud.positions).unwrap();
+    let spacing = crease::spatial::average_spacing(&cloud.positions).unwrap();
     let (mut k_sharp, mut k_flat) = (0usize, 0usize);
     let mut pred = truth.sharp.clone();
     let (mut missed, mut wrong) = (0u64, 0u64);
@@ -265,7 +265,7 @@ fn a_thin_detection_is_scored_fairly_by_the_tolerant_variant() {
         classes: None,
     };
     let r = evaluate(&labels, &EvalParams::default()).unwrap();
-    let sp = crease::geometry::average_spacing(&cloud.positions).unwrap();
+    let sp = crease::spatial::average_spacing(&cloud.positions).unwrap();
     let wide = evaluate(
         &labels,
         &EvalParams {

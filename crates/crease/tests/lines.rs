@@ -175,7 +175,7 @@ fn abc_nut_vertices() {
         })
         .collect();
     assert!(truth.len() > 100);
-    let spacing = crease::geometry::average_spacing(pts).expect("spacing");
+    let spacing = crease::spatial::average_spacing(pts).expect("spacing");
     let tol = 2.0 * spacing;
     let net = extract_lines(pts, &LinesParams::default()).expect("lines");
     let near_line = |p: Point3| {
@@ -304,7 +304,7 @@ fn classic_parts_sampled() {
             .map(|(e, _)| [vp[e[0] as usize], vp[e[1] as usize]])
             .collect();
         let pts = sample_surface(&mesh, 60_000);
-        let spacing = crease::geometry::average_spacing(&pts).expect("spacing");
+        let spacing = crease::spatial::average_spacing(&pts).expect("spacing");
         let tol = 2.0 * spacing;
         let net = extract_lines(&pts, &LinesParams::default()).expect("lines");
         let near_line = |p: Point3| {

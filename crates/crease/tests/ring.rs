@@ -5,7 +5,8 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use crease::estimate::{fit_plane, ring_normals};
+use crease::estimate::ring_normals;
+use crease::geometry::fit_plane;
 use crease::geometry::{Csr, Point3};
 use crease::spatial::ring::canonical_sign;
 use crease::spatial::{delaunay_rings, knn, Neighborhoods, RingParams, Rings};

@@ -4,11 +4,12 @@
 
 mod common;
 
+use crease::geometry::SurfaceType;
 use crease::geometry::{face_areas, MeshTopology};
 use crease::segment::recognize::GroupKind;
 use crease::segment::score::{param_error, read_abc_truth, score_faces, SegmentScore};
 use crease::segment::{segment_mesh, SegmentParams, Segmentation};
-use crease::synth::{self, MeshParams, Noise, NoiseScale, Shape, SurfaceType};
+use crease::synth::{self, MeshParams, Noise, NoiseScale, Shape};
 
 fn synth_mesh(name: &str, noise: f64) -> synth::SyntheticMesh {
     synth::mesh(
@@ -312,14 +313,14 @@ fn classic_meshes() {
         );
         (mesh, seg, assigned)
     };
-    let of_kind = |seg: &Segmentation, k: SurfaceType| -> Vec<crease::synth::SurfaceParams> {
+    let of_kind = |seg: &Segmentation, k: SurfaceType| -> Vec<crease::geometry::SurfaceParams> {
         seg.surfaces
             .iter()
             .filter(|s| s.kind == k)
             .map(|s| s.params)
             .collect()
     };
-    use crease::synth::SurfaceParams as P;
+    use crease::geometry::SurfaceParams as P;
     // cube.obj: 12 triangles, no vertex off a crease: six planes from the face patches.
     let (_, seg, assigned) = seg_of("cube.obj");
     assert_eq!(assigned, 12);
@@ -426,8 +427,8 @@ fn classic_meshes() {
 
 /// `p` with its lengths divided by `k` (a surface fitted to a part scaled by `k`, in the
 /// part's units).
-fn unscaled(p: &crease::synth::SurfaceParams, k: f64) -> crease::synth::SurfaceParams {
-    use crease::synth::SurfaceParams as P;
+fn unscaled(p: &crease::geometry::SurfaceParams, k: f64) -> crease::geometry::SurfaceParams {
+    use crease::geometry::SurfaceParams as P;
     let v = |a: [f64; 3]| a.map(|x| x / k);
     match *p {
         P::Plane { normal, offset } => P::Plane {

@@ -5,10 +5,11 @@
 mod common;
 
 use crease::geometry::MeshTopology;
+use crease::geometry::SurfaceType;
 use crease::segment::recognize::GroupKind;
 use crease::segment::score::{param_error, read_abc_truth, score_faces};
 use crease::segment::{segment_points, PointParams, PointSegmentation, SegmentParams};
-use crease::synth::{self, Noise, SampleParams, Shape, SurfaceType};
+use crease::synth::{self, Noise, SampleParams, Shape};
 
 fn sample(name: &str, n: usize, noise: f64) -> synth::SyntheticPart {
     synth::sample_points(
@@ -159,7 +160,9 @@ fn cloud_parts_every_surface_found() {
     let fillet = seg.groups.iter().any(|g| {
         g.kind == GroupKind::Fillet
             && match seg.surfaces[g.surfaces[0] as usize].params {
-                synth::SurfaceParams::Cylinder { radius, .. } => (radius - 0.1).abs() < 1e-3,
+                crease::geometry::SurfaceParams::Cylinder { radius, .. } => {
+                    (radius - 0.1).abs() < 1e-3
+                }
                 _ => false,
             }
     });
@@ -325,7 +328,7 @@ fn real_scans_are_segmented() {
         (n, assigned, seg)
     };
     let normal = |s: &crease::segment::SegmentSurface| match s.params {
-        synth::SurfaceParams::Plane { normal, .. } => normal,
+        crease::geometry::SurfaceParams::Plane { normal, .. } => normal,
         _ => panic!("not a plane: {:?}", s.kind),
     };
     // RealSense box.

@@ -4,9 +4,10 @@
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
+use crease::geometry::{SurfaceParams, SurfaceType};
 use crease::synth::{
     mesh, sample_points, two_cylinders_curve_length, CurveKind, FeatureCurve, MeshParams, Noise,
-    NoiseScale, SampleParams, Shape, SurfaceParams, SurfaceType, SyntheticPart,
+    NoiseScale, SampleParams, Shape, SyntheticPart,
 };
 
 fn sample(name: &str, n: usize) -> SyntheticPart {

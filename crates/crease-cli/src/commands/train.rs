@@ -10,8 +10,8 @@ use std::time::Instant;
 use clap::Args;
 use crease::meshfeat::svm::train;
 use crease::meshfeat::{
-    dihedral_labels, labels_from_pairs, read_abc_sharp_edges, synthetic_meshes, training_set,
-    EdgeMesh, FeatureParams, LabelledMesh, SetParams, TrainParams,
+    dihedral_labels, labels_from_pairs, read_abc_sharp_edges, training_set, EdgeMesh,
+    FeatureParams, LabelledMesh, SetParams, TrainParams,
 };
 
 use crate::args::Global;
@@ -196,7 +196,9 @@ pub fn run(g: &Global, a: &TrainArgs) -> anyhow::Result<()> {
         meshes.push(labelled(g, spec, a.label_degrees)?);
     }
     if a.synthetic {
-        meshes.extend(synthetic_meshes(&[40.0, 70.0])?);
+        for (name, m) in crease::synth::training_meshes(&[40.0, 70.0])? {
+            meshes.push(LabelledMesh::from_pairs(name, m.mesh, &m.sharp_edges)?);
+        }
     }
     let fp = FeatureParams::default();
     let sp = SetParams {

@@ -431,7 +431,7 @@ mod tests {
                 [x, y, 0.2 * x - 0.1 * y + 0.01 * x * y]
             })
             .collect();
-        let plane = super::super::fit_plane(pts.iter().map(|&p| (p, 1.0))).unwrap();
+        let plane = crate::geometry::fit_plane(pts.iter().map(|&p| (p, 1.0))).unwrap();
         let c = pts.iter().fold([0.0; 3], |s, p| add(s, *p));
         let c = scale(c, 1.0 / 30.0);
         let mut m = [0.0; 6];

@@ -1,10 +1,9 @@
-//! Estimators every detector stands on: local planes, normals and curvature.
+//! Estimators every detector stands on: normals and curvature.
 
 pub mod bezier;
 pub mod curvature;
 pub mod normals;
 pub mod orient;
-pub mod plane;
 pub mod ring_normal;
 
 pub use normals::{
@@ -12,5 +11,4 @@ pub use normals::{
     PcaWeight, Weighting,
 };
 pub use orient::orient_normals;
-pub use plane::{fit_plane, Plane};
 pub use ring_normal::ring_normals;

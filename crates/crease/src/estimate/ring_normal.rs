@@ -6,7 +6,7 @@
 
 use rayon::prelude::*;
 
-use crate::estimate::fit_plane;
+use crate::geometry::fit_plane;
 use crate::geometry::Point3;
 use crate::spatial::ring::{canonical_sign, Rings, COLLINEAR_RATIO};
 

@@ -15,7 +15,8 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::geometry::{average_spacing, Point3};
+use crate::geometry::Point3;
+use crate::spatial::average_spacing;
 use crate::spatial::KdIndex;
 use crate::{Error, Result};
 

@@ -12,12 +12,12 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use crate::geometry::names::{self, gt as attr};
 use crate::geometry::PointCloud;
-use crate::synth::attr;
 use crate::{Error, Result};
 
 /// Properties tried, in order, when no ground-truth property is named.
-pub const DEFAULT_PROPERTIES: [&str; 4] = [attr::SHARP, "sharp", "label", "class"];
+pub const DEFAULT_PROPERTIES: [&str; 4] = [attr::SHARP, names::SHARP, "label", "class"];
 
 /// The class of a point in a labelled benchmark.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]

@@ -1,14 +1,16 @@
-//! Geometry: point clouds, triangle meshes with their edge topology, bounding boxes, spacing.
+//! Geometry: point clouds, triangle meshes with their edge topology, bounding boxes, planes, analytic surfaces.
 
 mod aabb;
 mod attribute;
 pub mod cleanup;
 mod csr;
 mod mesh;
+pub mod names;
+pub mod plane;
 mod point_cloud;
 pub mod polyline;
+pub mod surface;
 pub(crate) use point_cloud::retain_by;
-pub mod spacing;
 pub mod topology;
 pub mod vec3;
 
@@ -17,9 +19,10 @@ pub use attribute::{Attribute, Attributes, ScalarKind};
 pub use cleanup::{clean_mesh, CleanupParams, CleanupReport};
 pub use csr::Csr;
 pub use mesh::TriMesh;
+pub use plane::{fit_plane, Plane};
 pub use point_cloud::{Point3, PointCloud};
 pub use polyline::{chain_segments, network_counts, NetworkCounts};
-pub use spacing::{average_spacing, average_spacing_with};
+pub use surface::{SurfaceParams, SurfaceType};
 pub use topology::{
     face_area, face_areas, face_normal, face_normals, MeshTopology, OneRing, VertexKind,
 };

@@ -6,9 +6,9 @@ use serde::Serialize;
 
 use super::{Geometry, ReadReport};
 use crate::geometry::{
-    average_spacing, clean_mesh, Aabb, Attribute, Attributes, CleanupParams, MeshTopology, Point3,
-    TriMesh,
+    clean_mesh, Aabb, Attribute, Attributes, CleanupParams, MeshTopology, Point3, TriMesh,
 };
+use crate::spatial::average_spacing;
 
 /// A summary of one attribute column.
 #[derive(Debug, Clone, Serialize)]

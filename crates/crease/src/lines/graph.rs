@@ -463,7 +463,7 @@ fn along_line(clusters: &Clusters, g: &Graph, p: u32, q: u32) -> bool {
         frontier = next;
     }
     let pts: Vec<Point3> = ring.iter().map(|&v| clusters.centers[v as usize]).collect();
-    let Some(plane) = crate::estimate::plane::fit_plane(pts.iter().map(|&p| (p, 1.0))) else {
+    let Some(plane) = crate::geometry::plane::fit_plane(pts.iter().map(|&p| (p, 1.0))) else {
         return false;
     };
     let axis = plane.axes[2];

@@ -18,7 +18,7 @@
 
 use rayon::prelude::*;
 
-use crate::estimate::fit_plane;
+use crate::geometry::fit_plane;
 use crate::geometry::{vec3, Point3};
 use crate::spatial::KdIndex;
 

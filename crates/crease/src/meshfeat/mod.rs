@@ -100,7 +100,7 @@ pub use potts::{potts_labels, potts_labels_unary, svm_unary, EdgePairs, PottsPar
 pub use surfaces::{intersection_scores, IntersectionParams};
 pub use svm::{default_model, SvmModel, TrainParams, TrainingSet};
 pub use tangent::{accept_angle, tangent_angles, TangentAngles, TangentParams, PAPER_SCALES};
-pub use train::{synthetic_meshes, training_set, LabelledMesh, SetParams};
+pub use train::{training_set, LabelledMesh, SetParams};
 pub use truth::{
     add_noise, classic_label_degrees, dihedral_labels, labels_from_pairs, read_abc_sharp_edges,
     sliver_edges, CLASSIC_LABELS,

@@ -20,7 +20,7 @@
 //!
 //! s_AB(e) = exp(−Σ_{v ∈ {a, b}} (d_A(v)² + d_B(v)²) / (8 W² σ̂²)) · min(1, ∠(n_A, n_B) / θ_t),
 //!
-//! d the orthogonal distance to the fitted surface ([`crate::segment::fit::signed_distance`]),
+//! d the orthogonal distance to the fitted surface ([`crate::geometry::surface::signed_distance`]),
 //! n_A and n_B the surfaces' normals at the edge's midpoint, θ_t the decision angle of the
 //! filtered dihedral angle ([`super::FILTERED_DEGREES`]), σ̂ the noise: the median distance of
 //! the segmented vertices to their own surface divided by 0.6745 (the median of |N(0, σ²)|),
@@ -59,8 +59,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::EdgeMesh;
+use crate::geometry::surface::{signed_distance, surface_normal};
 use crate::geometry::{vec3, Aabb, Csr, Point3};
-use crate::segment::fit::{signed_distance, surface_normal};
 use crate::segment::{segment_points, PointParams, SegmentParams};
 use crate::spatial::mesh_rings::vertex_k_rings;
 use crate::Result;
@@ -104,7 +104,7 @@ fn vertex_surfaces(
     em: &EdgeMesh,
     rings: &Csr,
     params: &IntersectionParams,
-) -> Result<Option<(Vec<i32>, Vec<crate::synth::SurfaceParams>)>> {
+) -> Result<Option<(Vec<i32>, Vec<crate::geometry::SurfaceParams>)>> {
     let p = em.mesh.positions();
     let n = p.len();
     let on_faces: Vec<u32> = (0..n as u32)
@@ -127,7 +127,7 @@ fn vertex_surfaces(
         return Ok(None);
     }
     let seg = segment_points(&pts, None, &SegmentParams::default(), &pp)?;
-    let surfaces: Vec<crate::synth::SurfaceParams> =
+    let surfaces: Vec<crate::geometry::SurfaceParams> =
         seg.surfaces.iter().map(|s| s.params).collect();
     let mut label = vec![-1i32; n];
     let mut is_sampled = vec![false; n];

@@ -1,5 +1,5 @@
-//! Training data for the learned classifier ([`super::svm`]): labelled meshes, the synthetic
-//! parts the default model is trained on, and the training set of section 6.3 built from
+//! Training data for the learned classifier ([`super::svm`]): labelled meshes (the default
+//! model's synthetic parts come from [`crate::synth::training_meshes`]) and the training set of section 6.3 built from
 //! clean and noisy versions of labelled meshes.
 
 use rayon::prelude::*;
@@ -9,7 +9,6 @@ use super::svm::TrainingSet;
 use super::truth::{add_noise, labels_from_pairs};
 use super::EdgeMesh;
 use crate::geometry::TriMesh;
-use crate::synth::{mesh as synth_mesh, MeshParams, Shape};
 use crate::{Error, Result};
 
 /// A mesh with per-edge ground truth (one label per edge of its [`EdgeMesh`], true = feature).
@@ -23,37 +22,18 @@ pub struct LabelledMesh {
     pub truth: Vec<bool>,
 }
 
-/// The synthetic parts of the default model: every shape of [`Shape::names`] tessellated
-/// with edges of 1/`per_side` of its largest side, labelled exactly (the mesh edges on
-/// sharp curves).
-pub fn synthetic_meshes(per_side: &[f64]) -> Result<Vec<LabelledMesh>> {
-    let mut out = Vec::new();
-    for &k in per_side {
-        for name in Shape::names() {
-            let shape = Shape::from_name(name)
-                .ok_or_else(|| Error::InvalidArgument(format!("unknown shape {name}")))?;
-            let m = synth_mesh(
-                &shape,
-                &MeshParams {
-                    target_edge: Some(shape.aabb().max_side() / k),
-                    ..Default::default()
-                },
-            )?;
-            let em = EdgeMesh::new(&m.mesh)?;
-            let (mut truth, _) = labels_from_pairs(&em.topo, &m.sharp_edges);
-            // Boundary edges are feature edges (section 2).
-            for &e in em.topo.boundary_edges() {
-                truth[e as usize] = true;
-            }
-            drop(em);
-            out.push(LabelledMesh {
-                name: format!("synth {name} /{k}"),
-                mesh: m.mesh,
-                truth,
-            });
+impl LabelledMesh {
+    /// A mesh labelled by the vertex pairs of its feature edges (e.g. a synthetic part's
+    /// `sharp_edges`); boundary edges are feature edges too (section 2).
+    pub fn from_pairs(name: String, mesh: TriMesh, pairs: &[[u32; 2]]) -> Result<LabelledMesh> {
+        let em = EdgeMesh::new(&mesh)?;
+        let (mut truth, _) = labels_from_pairs(&em.topo, pairs);
+        for &e in em.topo.boundary_edges() {
+            truth[e as usize] = true;
         }
+        drop(em);
+        Ok(LabelledMesh { name, mesh, truth })
     }
-    Ok(out)
 }
 
 /// Settings of [`training_set`].

@@ -42,9 +42,9 @@
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector3};
 use rayon::prelude::*;
 
+use crate::geometry::surface::{meridian, signed_distance};
 use crate::geometry::vec3::{add, cross, dist2, dot, norm, normalize, scale, sub};
-use crate::geometry::Point3;
-use crate::synth::{SurfaceParams, SurfaceType};
+use crate::geometry::{Point3, SurfaceParams, SurfaceType};
 
 /// Largest number of points an LM refinement iterates on (bigger regions are subsampled
 /// evenly, deterministically).
@@ -60,93 +60,6 @@ pub struct Fit {
     pub params: SurfaceParams,
     /// Weighted RMS of the orthogonal distances.
     pub rms: f64,
-}
-
-/// Coordinates `[ρ, h]` of `p` in the meridian half-plane of the axis through `origin` along
-/// the unit `dir`: distance from the axis and height along it.
-pub fn meridian(p: Point3, origin: Point3, dir: Point3) -> [f64; 2] {
-    let v = sub(p, origin);
-    let h = dot(v, dir);
-    [(dot(v, v) - h * h).max(0.0).sqrt(), h]
-}
-
-/// Signed orthogonal distance from `p` to the surface (positive on the side the surface's
-/// normal of [`surface_normal`] points to). For the cone, the distance to the double cone's
-/// generator line in the meridian half-plane (exact near the patch).
-pub fn signed_distance(s: &SurfaceParams, p: Point3) -> f64 {
-    match *s {
-        SurfaceParams::Plane { normal, offset } => dot(normal, p) - offset,
-        SurfaceParams::Cylinder {
-            axis_point,
-            axis_dir,
-            radius,
-        } => meridian(p, axis_point, axis_dir)[0] - radius,
-        SurfaceParams::Sphere { center, radius } => norm(sub(p, center)) - radius,
-        SurfaceParams::Cone {
-            apex,
-            axis_dir,
-            half_angle,
-        } => {
-            let [rho, h] = meridian(p, apex, axis_dir);
-            let (s, c) = half_angle.sin_cos();
-            rho * c - h * s
-        }
-        SurfaceParams::Torus {
-            center,
-            axis_dir,
-            major_radius,
-            minor_radius,
-        } => {
-            let [rho, h] = meridian(p, center, axis_dir);
-            (rho - major_radius).hypot(h) - minor_radius
-        }
-    }
-}
-
-/// Unit normal of the surface at the point nearest to `p` (outward for the closed types and
-/// the cylinder, away from the axis for the cone). Zero where undefined (on the axis).
-pub fn surface_normal(s: &SurfaceParams, p: Point3) -> Point3 {
-    let radial = |v: Point3, d: Point3| -> (Point3, f64, f64) {
-        let h = dot(v, d);
-        let r = sub(v, scale(d, h));
-        let rho = norm(r);
-        (
-            if rho > 0.0 {
-                scale(r, 1.0 / rho)
-            } else {
-                [0.0; 3]
-            },
-            rho,
-            h,
-        )
-    };
-    match *s {
-        SurfaceParams::Plane { normal, .. } => normal,
-        SurfaceParams::Cylinder {
-            axis_point,
-            axis_dir,
-            ..
-        } => radial(sub(p, axis_point), axis_dir).0,
-        SurfaceParams::Sphere { center, .. } => normalize(sub(p, center)).unwrap_or([0.0; 3]),
-        SurfaceParams::Cone {
-            apex,
-            axis_dir,
-            half_angle,
-        } => {
-            let (u, _, _) = radial(sub(p, apex), axis_dir);
-            let (s, c) = half_angle.sin_cos();
-            sub(scale(u, c), scale(axis_dir, s))
-        }
-        SurfaceParams::Torus {
-            center,
-            axis_dir,
-            major_radius,
-            ..
-        } => {
-            let (u, rho, h) = radial(sub(p, center), axis_dir);
-            normalize(add(scale(u, rho - major_radius), scale(axis_dir, h))).unwrap_or([0.0; 3])
-        }
-    }
 }
 
 /// Weighted RMS of the orthogonal distances of `pts` to `s`.
@@ -908,6 +821,7 @@ fn lm<const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::surface::surface_normal;
     use rand::{Rng, SeedableRng};
     use rand_distr::StandardNormal;
     use rand_pcg::Pcg64;

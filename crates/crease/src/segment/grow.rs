@@ -39,10 +39,11 @@
 
 use crate::geometry::vec3::{dot, scale};
 use crate::geometry::{MeshTopology, Point3, TriMesh};
+use crate::geometry::{SurfaceParams, SurfaceType};
 use crate::spatial::Adjacency;
-use crate::synth::{SurfaceParams, SurfaceType};
 
-use super::fit::{fit, signed_distance, surface_normal, Fit};
+use super::fit::{fit, Fit};
+use crate::geometry::surface::{signed_distance, surface_normal};
 
 /// Tolerances of the compatibility tests.
 #[derive(Debug, Clone, Copy)]

@@ -61,7 +61,7 @@
 //! surfaces. At the powers of two 2^10 and 2^-10 all were the same bit for bit.
 //!
 //! Surface-type codes (PLY `surface_type`, uchar) are those of
-//! [`SurfaceType`](crate::synth::SurfaceType): plane 0, cylinder 1, cone 2, sphere 3, torus 4,
+//! [`SurfaceType`](crate::geometry::SurfaceType): plane 0, cylinder 1, cone 2, sphere 3, torus 4,
 //! 255 unassigned.
 
 pub mod fit;
@@ -78,8 +78,8 @@ use serde::Serialize;
 
 use crate::estimate::bezier::{bezier_curvature_with_sharp, BezierCurvature, BezierParams};
 use crate::geometry::{face_areas, Aabb, MeshTopology, Point3, TriMesh};
+use crate::geometry::{SurfaceParams, SurfaceType};
 use crate::spatial::Adjacency;
-use crate::synth::{SurfaceParams, SurfaceType};
 use crate::{Error, Result};
 
 pub use fit::Fit;
@@ -355,11 +355,14 @@ fn noise_tolerance<G: Adjacency>(
                 .filter_map(move |v| {
                     let f = f.as_ref()?;
                     let p = ctx.pos[v as usize];
-                    let n = fit::surface_normal(&f.params, p);
+                    let n = crate::geometry::surface::surface_normal(&f.params, p);
                     let c = crate::geometry::vec3::dot(n, ctx.vnormal[v as usize])
                         .abs()
                         .min(1.0);
-                    Some((fit::signed_distance(&f.params, p).abs(), c.acos()))
+                    Some((
+                        crate::geometry::surface::signed_distance(&f.params, p).abs(),
+                        c.acos(),
+                    ))
                 })
                 .collect::<Vec<_>>()
         })
@@ -990,7 +993,8 @@ fn crease_band<G: Adjacency>(
             nb.iter()
                 .map(|&s| {
                     let f = &regions[s as usize].fit;
-                    let d = fit::signed_distance(&f.params, pos[v as usize]).abs();
+                    let d =
+                        crate::geometry::surface::signed_distance(&f.params, pos[v as usize]).abs();
                     (d / f.rms.max(floor), s)
                 })
                 .fold((f64::INFINITY, -1), |a, b| if b.0 < a.0 { b } else { a })

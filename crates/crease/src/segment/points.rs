@@ -71,7 +71,7 @@ use crate::geometry::{Aabb, Csr, Point3};
 use crate::spatial::{knn, morton_order, Adjacency};
 use crate::{Error, Result};
 
-use super::fit::signed_distance;
+use crate::geometry::surface::signed_distance;
 
 /// Parameters of the point-cloud path (the thresholds are those of [`SegmentParams`]).
 #[derive(Debug, Clone, Copy, PartialEq)]

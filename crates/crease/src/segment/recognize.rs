@@ -25,7 +25,7 @@ use serde::Serialize;
 
 use crate::geometry::vec3::{cross, dot, norm, normalize, sub};
 use crate::geometry::Point3;
-use crate::synth::{SurfaceParams, SurfaceType};
+use crate::geometry::{SurfaceParams, SurfaceType};
 
 use super::SegmentSurface;
 

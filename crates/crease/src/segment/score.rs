@@ -10,7 +10,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::geometry::vec3::{cross, dot, norm, sub};
-use crate::synth::{SurfaceParams, SurfaceType};
+use crate::geometry::{SurfaceParams, SurfaceType};
 use crate::{Error, Result};
 
 /// How one ground-truth surface was recovered.

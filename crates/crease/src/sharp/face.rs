@@ -50,7 +50,7 @@
 use rayon::prelude::*;
 
 use crate::estimate::normals::smallest_eigen4;
-use crate::estimate::plane::Moments;
+use crate::geometry::plane::Moments;
 use crate::geometry::{vec3, Point3};
 use crate::spatial::Neighborhoods;
 

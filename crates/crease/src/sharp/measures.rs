@@ -11,8 +11,8 @@ use rayon::prelude::*;
 
 use crate::estimate::curvature::fit_point;
 use crate::estimate::normals::{smallest_eigen4, weighted_pca};
-use crate::estimate::plane::Moments;
 use crate::estimate::PcaWeight;
+use crate::geometry::plane::Moments;
 use crate::geometry::{vec3, Point3};
 
 /// The per-point measure a detector thresholds.

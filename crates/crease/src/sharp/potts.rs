@@ -57,7 +57,7 @@
 
 use rayon::prelude::*;
 
-use crate::estimate::fit_plane;
+use crate::geometry::fit_plane;
 use crate::geometry::{vec3, Point3};
 use crate::graphcut::BinaryEnergy;
 use crate::spatial::Neighborhoods;

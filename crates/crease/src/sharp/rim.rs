@@ -23,7 +23,7 @@
 //! is 80, twice the largest scale of tran section 4.2, since a sheet's neighbourhood holds both
 //! faces: the same area of the sheet as 40 neighbours on one face.
 
-use crate::estimate::fit_plane;
+use crate::geometry::fit_plane;
 use crate::geometry::{vec3, Point3};
 use crate::spatial::KdIndex;
 

@@ -74,8 +74,8 @@
 
 use rayon::prelude::*;
 
+use crate::geometry::surface::{signed_distance, surface_normal};
 use crate::geometry::{vec3, Point3};
-use crate::segment::fit::{signed_distance, surface_normal};
 use crate::segment::{segment_points, PointParams, SegmentParams};
 use crate::spatial::KdIndex;
 use crate::spatial::Neighborhoods;

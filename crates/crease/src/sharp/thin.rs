@@ -34,7 +34,7 @@
 
 use rayon::prelude::*;
 
-use crate::estimate::fit_plane;
+use crate::geometry::fit_plane;
 use crate::geometry::{vec3, Point3};
 
 /// Two detected points are compared only when their displacement directions are at most this

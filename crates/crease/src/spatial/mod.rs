@@ -8,6 +8,7 @@ pub mod mesh_rings;
 pub mod morton;
 pub mod radius;
 pub mod ring;
+pub mod spacing;
 
 pub use graph::Adjacency;
 pub use kdtree::KdIndex;
@@ -17,3 +18,4 @@ pub use knn::{
 pub use morton::morton_order;
 pub use radius::{knn_within, radius_neighbors};
 pub use ring::{delaunay_rings, RingParams, Rings};
+pub use spacing::{average_spacing, average_spacing_with};

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use spade::handles::FixedVertexHandle;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
-use crate::estimate::fit_plane;
+use crate::geometry::fit_plane;
 use crate::geometry::{Csr, Point3};
 use crate::spatial::Neighborhoods;
 use crate::{Error, Result};

@@ -21,8 +21,9 @@ use rand_pcg::Pcg64;
 use super::sample::{check_sigma, check_tolerance, mix, truth_attributes};
 use super::shapes::{rounded_cube_corner_id, rounded_cube_fillet_id, rounded_cube_plane_id, Model};
 use super::truth::{CurveIndex, CurveKind};
-use super::{attr, FeatureCurve, Noise, NoiseScale, Shape, Surface, SurfaceType};
+use super::{attr, FeatureCurve, Noise, NoiseScale, Shape, Surface};
 use crate::geometry::vec3::{add, cross, dot, normalize, scale, sub};
+use crate::geometry::SurfaceType;
 use crate::geometry::{Attribute, Point3, PointCloud, ScalarKind, TriMesh};
 use crate::{Error, Result};
 
@@ -469,4 +470,26 @@ impl SyntheticMesh {
     pub fn curves_geometry(&self) -> crate::io::Geometry {
         super::sample::curves_geometry(&self.curves)
     }
+}
+
+/// The synthetic parts the default edge classifier is trained on: every shape of
+/// [`Shape::names`] tessellated with edges of 1/`per_side` of its largest side, named
+/// `synth NAME /PER_SIDE`; each [`SyntheticMesh::sharp_edges`] labels it exactly.
+pub fn training_meshes(per_side: &[f64]) -> Result<Vec<(String, SyntheticMesh)>> {
+    let mut out = Vec::new();
+    for &k in per_side {
+        for name in Shape::names() {
+            let shape = Shape::from_name(name)
+                .ok_or_else(|| Error::InvalidArgument(format!("unknown shape {name}")))?;
+            let m = mesh(
+                &shape,
+                &MeshParams {
+                    target_edge: Some(shape.aabb().max_side() / k),
+                    ..Default::default()
+                },
+            )?;
+            out.push((format!("synth {name} /{k}"), m));
+        }
+    }
+    Ok(out)
 }

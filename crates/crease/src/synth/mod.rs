@@ -17,7 +17,7 @@
 //! | `gt_sharp_curve`     | I32  | index in `curves` of the nearest sharp curve, -1 if none        |
 //! | `gt_smooth_curve`    | I32  | index in `curves` of the nearest smooth curve, -1 if none       |
 //! | `gt_surface`         | I32  | surface id (index in `surfaces`), -1 for outliers               |
-//! | `gt_surface_type`    | U8   | [`SurfaceType`] code, 255 for outliers                          |
+//! | `gt_surface_type`    | U8   | [`SurfaceType`](crate::geometry::SurfaceType) code, 255 for outliers                          |
 //! | `gt_outlier`         | U8   | 1 for outliers                                                  |
 //!
 //! For outliers the distances are measured from the outlier's own position. Normals are the
@@ -33,10 +33,10 @@ mod truth;
 
 use serde::Serialize;
 
-pub use mesh::{mesh, MeshParams, SyntheticMesh};
+pub use mesh::{mesh, training_meshes, MeshParams, SyntheticMesh};
 pub use sample::{sample_points, SampleParams, SyntheticPart};
 pub use shapes::{two_cylinders_curve_length, Shape};
-pub use surfaces::{Surface, SurfaceParams, SurfaceType};
+pub use surfaces::Surface;
 pub use truth::{arc_distance, segment_distance, CurveGeometry, CurveKind, FeatureCurve};
 
 /// Gaussian noise added to the positions; the value is the standard deviation sigma, relative
@@ -74,23 +74,4 @@ pub enum NoiseScale {
 }
 
 /// The per-element ground-truth attribute names (see the module documentation).
-pub mod attr {
-    /// Exact distance to the nearest sharp curve (F32).
-    pub const EDGE_DISTANCE: &str = "gt_edge_distance";
-    /// Sharp label (U8).
-    pub const SHARP: &str = "gt_sharp";
-    /// Exact distance to the nearest smooth curve (F32).
-    pub const SMOOTH_DISTANCE: &str = "gt_smooth_distance";
-    /// Smooth label (U8).
-    pub const SMOOTH: &str = "gt_smooth";
-    /// Index of the nearest sharp curve (I32, -1 if none).
-    pub const SHARP_CURVE: &str = "gt_sharp_curve";
-    /// Index of the nearest smooth curve (I32, -1 if none).
-    pub const SMOOTH_CURVE: &str = "gt_smooth_curve";
-    /// Surface id (I32, -1 for outliers).
-    pub const SURFACE: &str = "gt_surface";
-    /// Surface type code (U8, 255 for outliers).
-    pub const SURFACE_TYPE: &str = "gt_surface_type";
-    /// Outlier flag (U8).
-    pub const OUTLIER: &str = "gt_outlier";
-}
+pub use crate::geometry::names::gt as attr;

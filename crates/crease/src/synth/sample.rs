@@ -15,8 +15,9 @@ use serde_json::json;
 
 use super::shapes::Model;
 use super::truth::{CurveIndex, CurveKind};
-use super::{attr, FeatureCurve, Noise, NoiseScale, Shape, Surface, SurfaceType};
+use super::{attr, FeatureCurve, Noise, NoiseScale, Shape, Surface};
 use crate::geometry::vec3::{add, scale};
+use crate::geometry::SurfaceType;
 use crate::geometry::{Attribute, Point3, PointCloud, ScalarKind};
 use crate::io::Geometry;
 use crate::{Error, Result};

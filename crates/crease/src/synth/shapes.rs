@@ -11,9 +11,10 @@
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
-use super::surfaces::{frame, Domain, Patch, Region2, Surface, SurfaceParams, Trim};
+use super::surfaces::{frame, Domain, Patch, Region2, Surface, Trim};
 use super::truth::{CurveKind, FeatureCurve};
 use crate::geometry::vec3::{dot, scale};
+use crate::geometry::SurfaceParams;
 use crate::geometry::{Aabb, Point3};
 use crate::{Error, Result};
 

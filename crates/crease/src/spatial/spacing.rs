@@ -5,8 +5,8 @@
 
 use rayon::prelude::*;
 
-use super::Point3;
-use crate::spatial::KdIndex;
+use super::KdIndex;
+use crate::geometry::Point3;
 
 /// Queries beyond this many points are subsampled (every `n / MAX_QUERIES`-th point): the mean
 /// of 200k nearest-neighbour distances is within a fraction of a percent of the full mean, and
