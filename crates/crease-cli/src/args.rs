@@ -36,6 +36,10 @@ pub struct Global {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// The whole job in one command: sharp points, the curve network (sharp and fillet lines)
+    /// and the analytic surfaces of a cloud, or the feature edges and surfaces of a mesh, from
+    /// one shared analysis, written into a folder with a JSON summary and a picture.
+    Run(crate::commands::run::RunArgs),
     /// Describe a file: kind, counts, bounding box, spacing, attributes, problems found.
     Info {
         /// Point cloud or mesh (.ply .obj .off .stl .xyz .txt .pcd .las .laz .e57).

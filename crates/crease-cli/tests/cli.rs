@@ -394,3 +394,174 @@ fn demo_writes_its_results() {
         assert!(ff > 0.75 && ff > df + 0.2, "F1 {m} {ff}, dihedral {df}");
     }
 }
+
+/// Reads a PLY attribute as 0/1 flags.
+fn flags(cloud: &crease::PointCloud, name: &str) -> Vec<bool> {
+    cloud
+        .attribute(name)
+        .unwrap_or_else(|| panic!("attribute {name}"))
+        .values
+        .iter()
+        .map(|&v| v > 0.0)
+        .collect()
+}
+
+/// Fraction of the points whose detected surface's most common true surface is their own.
+fn surface_purity(found: &[f64], truth: &[f64]) -> f64 {
+    let mut votes: std::collections::BTreeMap<(i64, i64), usize> = Default::default();
+    for (&f, &t) in found.iter().zip(truth) {
+        *votes.entry((f as i64, t as i64)).or_default() += 1;
+    }
+    let mut best: std::collections::BTreeMap<i64, (usize, i64)> = Default::default();
+    for (&(f, t), &c) in &votes {
+        let b = best.entry(f).or_insert((0, t));
+        if c > b.0 {
+            *b = (c, t);
+        }
+    }
+    let good = found
+        .iter()
+        .zip(truth)
+        .filter(|(&f, &t)| f >= 0.0 && best[&(f as i64)].1 == t as i64)
+        .count();
+    good as f64 / found.len() as f64
+}
+
+#[test]
+fn run_on_a_cloud_shares_one_analysis_and_writes_every_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = common::synth(
+        dir.path(),
+        &["synth", "fillet-chamfer-cone", "-n", "20000"],
+        "part.ply",
+    );
+    let out = dir.path().join("made/by/run");
+    let a = crease()
+        .args(["run", "--json"])
+        .arg(&input)
+        .arg("-o")
+        .arg(&out)
+        .assert()
+        .success();
+    let s = json_of(&a.get_output().stdout);
+    // One neighbour query, one normal estimation, one noise measure, one segmentation.
+    for piece in ["neighbours", "normals", "noise", "segmentations"] {
+        assert_eq!(s["analysis"][piece], 1, "{piece}: {}", s["analysis"]);
+    }
+    let on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(on_disk["analysis"], s["analysis"]);
+
+    let (src, _) = crease::io::read(&input, &Default::default()).unwrap();
+    let (lab, _) = crease::io::read(out.join("labels.ply"), &Default::default()).unwrap();
+    assert_eq!(
+        src.points.positions, lab.points.positions,
+        "input order kept"
+    );
+    // Sharp points: distance-tolerant F1 against the exact labels (README: 0.915 for `sharp`).
+    let pts = &lab.points.positions;
+    let tol = crease::eval::tolerant::default_tolerance(pts).unwrap();
+    let f1 = crease::eval::tolerant::tolerant_scores(
+        pts,
+        &flags(&lab.points, "sharp"),
+        &flags(&lab.points, "gt_sharp"),
+        tol,
+    )
+    .unwrap()
+    .f1;
+    assert!(f1 > 0.88, "tolerant F1 {f1}");
+    // Surfaces: the part's 10 patches, each found as one surface.
+    assert_eq!(s["surfaces"], 10);
+    let found = &lab.points.attribute("surface").unwrap().values;
+    let truth = &lab.points.attribute("gt_surface").unwrap().values;
+    let purity = surface_purity(found, truth);
+    assert!(purity > 0.97, "surface purity {purity}");
+    let prims: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("surfaces.json")).unwrap()).unwrap();
+    assert_eq!(prims["surfaces"].as_array().unwrap().len(), 10);
+    // The curve network: the part's sharp curves as closed polylines, the fillet's borders.
+    let obj = std::fs::read_to_string(out.join("network.obj")).unwrap();
+    let (mut group, mut sharp_lines, mut smooth_lines) = ("", 0, 0);
+    for line in obj.lines() {
+        if let Some(g) = line.strip_prefix("g ") {
+            group = g;
+        } else if line.starts_with("l ") {
+            match group {
+                "sharp" => sharp_lines += 1,
+                "smooth" => smooth_lines += 1,
+                g => panic!("polyline in group {g:?}"),
+            }
+        }
+    }
+    assert_eq!(s["sharp_polylines"], sharp_lines);
+    assert!(
+        (9..=14).contains(&sharp_lines),
+        "{sharp_lines} sharp polylines"
+    );
+    assert_eq!(smooth_lines, 2, "the fillet's two borders");
+    let png = std::fs::read(out.join("picture.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+}
+
+#[test]
+fn run_on_a_mesh_finds_its_feature_edges_and_surfaces() {
+    let dir = tempfile::tempdir().unwrap();
+    let shape = crease::synth::Shape::from_name("fillet-chamfer-cone").unwrap();
+    let m = crease::synth::mesh(&shape, &Default::default()).unwrap();
+    let input = dir.path().join("part.ply");
+    crease::io::write(
+        &input,
+        &crease::io::Geometry::from_mesh(m.mesh.clone()),
+        &Default::default(),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let a = crease()
+        .args(["run", "--json"])
+        .arg(&input)
+        .arg("-o")
+        .arg(&out)
+        .assert()
+        .success();
+    let s = json_of(&a.get_output().stdout);
+    assert_eq!(s["kind"], "mesh");
+    assert_eq!(s["surfaces"], 10);
+    let (lab, _) = crease::io::read(out.join("labels.ply"), &Default::default()).unwrap();
+    let truth: std::collections::BTreeSet<[u32; 2]> = m.sharp_edges.iter().copied().collect();
+    let sharp = &lab.edge_attributes.get("sharp").unwrap().values;
+    let (mut tp, mut fp) = (0usize, 0usize);
+    for (e, &v) in lab.edges.iter().zip(sharp) {
+        if v > 0.0 {
+            let key = [e[0].min(e[1]), e[0].max(e[1])];
+            if truth.contains(&key) {
+                tp += 1;
+            } else {
+                fp += 1;
+            }
+        }
+    }
+    let precision = tp as f64 / (tp + fp).max(1) as f64;
+    let recall = tp as f64 / truth.len() as f64;
+    assert!(
+        precision > 0.97 && recall > 0.97,
+        "P {precision} R {recall}"
+    );
+    let found = &lab.face_attributes.get("surface").unwrap().values;
+    let gt = &lab.face_attributes.get("gt_surface").unwrap().values;
+    let purity = surface_purity(found, gt);
+    assert!(purity > 0.99, "face purity {purity}");
+}
+
+#[test]
+fn run_refuses_a_file_as_its_output_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = common::synth(dir.path(), &["synth", "cube", "-n", "2000"], "cube.ply");
+    crease()
+        .arg("run")
+        .arg(&input)
+        .arg("-o")
+        .arg(&input)
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("not a folder"));
+}

@@ -11,6 +11,7 @@
 //!
 //! Each stage is a plain function: inputs and a `Params` struct in, a result struct out.
 
+pub mod analysis;
 pub mod error;
 pub mod estimate;
 pub mod eval;

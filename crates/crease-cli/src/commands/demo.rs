@@ -53,6 +53,25 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
     )?;
     time("write", s);
 
+    // 1b. The whole job in one command (`crease run part.ply -o run/`): sharp points, curve
+    //     network and surfaces from one shared analysis.
+    let s = Stage::start("crease run part.ply -o run/", g.quiet);
+    let quiet_global = Global {
+        json: false,
+        quiet: true,
+        ..g.clone()
+    };
+    super::run::run(
+        &quiet_global,
+        &super::run::RunArgs {
+            input: cloud_path.clone(),
+            output: dir.join("run"),
+            no_picture: false,
+            ascii: false,
+        },
+    )?;
+    time("run", s);
+
     // 2. Estimators: k-nearest neighbours once, PCA normals (oriented) and quadric curvature
     //    from them, scored against the exact normals of the synthetic part.
     let s = Stage::start("normals and curvature", g.quiet);
@@ -458,7 +477,8 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
                   "part-mesh.ply", "part-sharp.png", "part-surfaces.png", "part-curvature.png",
                   "part-mesh.png", "part-detected-sharp.png", "part-lines.obj", "part-lines.png",
                   "part-network.obj", "part-network.png", "part-segments.ply",
-                  "part-segments.png", "part-edges.obj", "part-edges.png"],
+                  "part-segments.png", "part-edges.obj", "part-edges.png", "run/labels.ply",
+                  "run/network.obj", "run/surfaces.json", "run/summary.json", "run/picture.png"],
         "seconds": timings,
     });
     std::fs::write(

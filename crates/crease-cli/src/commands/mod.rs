@@ -10,6 +10,7 @@ mod info;
 pub(crate) mod lines;
 pub(crate) mod normals;
 mod render;
+pub(crate) mod run;
 pub(crate) mod segment;
 pub(crate) mod sharp;
 mod synth;
@@ -26,6 +27,7 @@ use crate::ui::Stage;
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let g = &cli.global;
     match cli.command {
+        Command::Run(a) => run::run(g, &a),
         Command::Info { input } => info::run(g, &input),
         Command::Convert {
             input,

@@ -2,6 +2,7 @@
 
 pub mod bezier;
 pub mod curvature;
+pub mod noise;
 pub mod normals;
 pub mod orient;
 pub mod ring_normal;

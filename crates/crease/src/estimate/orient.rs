@@ -26,6 +26,25 @@ pub fn orient_normals(
     normals: &[Point3],
     nbrs: &Neighborhoods,
 ) -> Result<Vec<Point3>> {
+    orient_normals_k(points, normals, nbrs, nbrs.k())
+}
+
+/// [`orient_normals`] over the first `k` neighbours of each row (the graph of a smaller k from
+/// lists computed for a larger one).
+///
+/// Errors as [`orient_normals`], and when `k` is 0 or exceeds `nbrs.k()`.
+pub fn orient_normals_k(
+    points: &[Point3],
+    normals: &[Point3],
+    nbrs: &Neighborhoods,
+    k: usize,
+) -> Result<Vec<Point3>> {
+    if k == 0 || k > nbrs.k() {
+        return Err(Error::InvalidArgument(format!(
+            "orient normals over k = {k} neighbours from lists of {}",
+            nbrs.k()
+        )));
+    }
     let n = points.len();
     if normals.len() != n || nbrs.len() != n {
         return Err(Error::InvalidArgument(format!(
@@ -39,7 +58,7 @@ pub fn orient_normals(
             "orient normals: a neighbour index is out of range for {n} points"
         )));
     }
-    let tree = spanning_forest(normals, nbrs);
+    let tree = spanning_forest(normals, nbrs, k);
     let mut out = normals.to_vec();
     let mut done = vec![false; n];
     let mut queue: Vec<u32> = Vec::with_capacity(n);
@@ -72,7 +91,7 @@ pub fn orient_normals(
 
 /// The minimum spanning forest of the symmetrised kNN graph weighted by 1 − |n_i·n_j|, as a
 /// symmetric adjacency CSR.
-fn spanning_forest(normals: &[Point3], nbrs: &Neighborhoods) -> Csr {
+fn spanning_forest(normals: &[Point3], nbrs: &Neighborhoods, k: usize) -> Csr {
     let n = normals.len();
     // Each undirected edge once: from i to j > i, and from i to j < i only when i is not in
     // j's row (then j's row did not produce it). Weight as f32 bits (order-preserving for
@@ -80,10 +99,10 @@ fn spanning_forest(normals: &[Point3], nbrs: &Neighborhoods) -> Csr {
     let mut edges: Vec<[u32; 3]> = (0..n)
         .into_par_iter()
         .flat_map_iter(|i| {
-            let row = nbrs.of(i);
+            let row = nbrs.prefix(i, k);
             row.iter().filter_map(move |&j| {
                 let ju = j as usize;
-                if ju == i || (ju < i && nbrs.of(ju).contains(&(i as u32))) {
+                if ju == i || (ju < i && nbrs.prefix(ju, k).contains(&(i as u32))) {
                     return None;
                 }
                 let (a, b) = if ju < i { (j, i as u32) } else { (i as u32, j) };

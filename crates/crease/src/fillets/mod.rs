@@ -48,9 +48,10 @@ use serde::Serialize;
 pub use histogram::{Search, Split, L_START};
 pub use labels::Label;
 
+use crate::analysis::CloudAnalysis;
 use crate::estimate::curvature::{quadric_curvature, QuadricParams};
 use crate::geometry::{chain_segments, Csr, Point3};
-use crate::lines::{self, LineNetwork, LinesParams, Smoothing};
+use crate::lines::{self, FirstOrder, LineNetwork, LinesParams, Smoothing};
 use crate::spatial::knn;
 use crate::{Error, Result};
 
@@ -309,15 +310,7 @@ pub struct Timing {
     pub smooth_lines: f64,
 }
 
-/// Runs the pipeline of the module documentation on `points`; with `with_sharp` the sharp lines
-/// of the same first-order segmentation are returned too (the whole curve network).
-///
-/// Errors: too few points, non-finite coordinates, invalid parameters.
-pub fn extract_fillets(
-    points: &[Point3],
-    params: &FilletParams,
-    with_sharp: bool,
-) -> Result<Fillets> {
+fn check_params(params: &FilletParams) -> Result<()> {
     if !(0.0..0.5).contains(&params.trim) {
         return Err(Error::InvalidArgument(format!(
             "the trimmed fraction must be in [0, 0.5), got {}",
@@ -337,8 +330,66 @@ pub fn extract_fillets(
             ));
         }
     }
-    let mut seconds = Timing::default();
+    Ok(())
+}
+
+/// Runs the pipeline of the module documentation on `points`; with `with_sharp` the sharp lines
+/// of the same first-order segmentation are returned too (the whole curve network).
+///
+/// Errors: too few points, non-finite coordinates, invalid parameters.
+pub fn extract_fillets(
+    points: &[Point3],
+    params: &FilletParams,
+    with_sharp: bool,
+) -> Result<Fillets> {
+    check_params(params)?;
     let first = lines::first_order(points, &params.lines)?;
+    extract_fillets_with(points, &first, params, with_sharp)
+}
+
+/// [`extract_fillets`] on a shared analysis of the cloud: the first-order structure is built
+/// from its neighbour lists (`params.lines.k` must be at most its `max_k`); per-point outputs
+/// are in the cloud's input order.
+///
+/// Errors: as [`extract_fillets`], and the analysis' neighbour errors.
+pub fn extract_fillets_from(
+    analysis: &CloudAnalysis,
+    params: &FilletParams,
+    with_sharp: bool,
+) -> Result<Fillets> {
+    check_params(params)?;
+    let points = analysis.points();
+    let first = lines::first_order_with(points, analysis.neighbours()?, &params.lines)?;
+    let mut f = extract_fillets_with(points, &first, params, with_sharp)?;
+    f.region = analysis.to_input_order(&f.region);
+    f.curvature = analysis.to_input_order(&f.curvature);
+    f.label = analysis.to_input_order(&f.label);
+    f.patch = analysis.to_input_order(&f.patch);
+    if let Some(net) = f.sharp.as_mut() {
+        net.segmentation.labels = analysis.to_input_order(&net.segmentation.labels);
+    }
+    Ok(f)
+}
+
+/// [`extract_fillets`] on a first-order structure already computed for `points` with
+/// `params.lines` (see [`extract_fillets_from`]).
+///
+/// Errors: as [`extract_fillets`], and a first-order structure of another number of points.
+pub fn extract_fillets_with(
+    points: &[Point3],
+    first: &FirstOrder,
+    params: &FilletParams,
+    with_sharp: bool,
+) -> Result<Fillets> {
+    check_params(params)?;
+    if first.segmentation.labels.len() != points.len() {
+        return Err(Error::InvalidArgument(format!(
+            "fillets: a first-order segmentation of {} points for {} points",
+            first.segmentation.labels.len(),
+            points.len()
+        )));
+    }
+    let mut seconds = Timing::default();
     seconds.first_order = first.seconds;
     let sharp = if with_sharp {
         let t = Instant::now();

@@ -49,9 +49,10 @@ use serde::Serialize;
 pub use graph::{CloseReport, Graph};
 pub use segment::{region_grow, Segmentation};
 
+use crate::analysis::CloudAnalysis;
 use crate::estimate::ring_normals;
 use crate::geometry::{chain_segments, Csr, Point3};
-use crate::spatial::{delaunay_rings, knn, RingParams};
+use crate::spatial::{delaunay_rings, knn, Neighborhoods, RingParams};
 use crate::{Error, Result};
 
 /// Parameters of [`extract_lines`].
@@ -238,8 +239,23 @@ pub fn first_order(points: &[Point3], params: &LinesParams) -> Result<FirstOrder
     check_params(params)?;
     let t = Instant::now();
     let nbrs = knn(points, params.k)?;
-    let rings = delaunay_rings(points, &nbrs, &RingParams { k: params.k })?;
-    drop(nbrs);
+    let mut first = first_order_with(points, &nbrs, params)?;
+    first.seconds = t.elapsed().as_secs_f64();
+    Ok(first)
+}
+
+/// [`first_order`] from precomputed neighbour lists (at least `params.k` per row, nearest first;
+/// the Delaunay 1-rings read the first `params.k`).
+///
+/// Errors: neighbour lists shorter than `params.k`, invalid parameters.
+pub fn first_order_with(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    params: &LinesParams,
+) -> Result<FirstOrder> {
+    check_params(params)?;
+    let t = Instant::now();
+    let rings = delaunay_rings(points, nbrs, &RingParams { k: params.k })?;
     let normals = ring_normals(points, &rings);
     let adjacency = rings.symmetrized();
     let mut normals = normals;
@@ -273,6 +289,23 @@ pub fn first_order(points: &[Point3], params: &LinesParams) -> Result<FirstOrder
 /// Errors: fewer than k + 1 points, non-finite coordinates, invalid parameters.
 pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetwork> {
     let first = first_order(points, params)?;
+    lines_of(points, &first, params)
+}
+
+/// [`extract_lines`] on a shared analysis of the cloud: the Delaunay 1-rings are built from its
+/// neighbour lists (`params.k` must be at most its `max_k`); the network's per-point
+/// segmentation is in the cloud's input order.
+///
+/// Errors: the analysis' neighbour errors, `params.k` above its `max_k`, invalid parameters.
+pub fn extract_lines_from(analysis: &CloudAnalysis, params: &LinesParams) -> Result<LineNetwork> {
+    let first = first_order_with(analysis.points(), analysis.neighbours()?, params)?;
+    let mut net = lines_of(analysis.points(), &first, params)?;
+    net.segmentation.labels = analysis.to_input_order(&net.segmentation.labels);
+    Ok(net)
+}
+
+/// Steps 2 to 7 on the sharp-line segmentation of `first`.
+fn lines_of(points: &[Point3], first: &FirstOrder, params: &LinesParams) -> Result<LineNetwork> {
     let boundary = params.boundary.then_some(first.boundary.as_slice());
     let smoothing = if params.smooth {
         Smoothing::PatchIntersection

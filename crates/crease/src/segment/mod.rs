@@ -84,7 +84,11 @@ use crate::{Error, Result};
 
 pub use fit::Fit;
 pub use labels::{label, LabelParams};
-pub use points::{segment_points, PointParams, PointSegmentation};
+pub(crate) use points::segment_core;
+pub use points::{
+    estimated_normals, neighbours_needed, segment_points, segment_points_with, PointParams,
+    PointSegmentation,
+};
 
 /// Parameters of [`segment_mesh`]. `Default` = the paper's values (made scale-invariant as
 /// documented on each field).

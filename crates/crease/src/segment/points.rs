@@ -65,10 +65,11 @@ use rayon::prelude::*;
 use super::SegmentSurface;
 use super::{check_params, grow, recognize, segment_graph, GraphInput, SegmentParams};
 use crate::estimate::bezier::{two_pass_curvature, PatchModel};
-use crate::estimate::{orient_normals, pca_normals, PcaParams};
+use crate::estimate::orient::orient_normals_k;
+use crate::estimate::{pca_normals, PcaParams};
 use crate::geometry::vec3::{dist, dot, normalize};
 use crate::geometry::{Aabb, Csr, Point3};
-use crate::spatial::{knn, morton_order, Adjacency};
+use crate::spatial::{knn, morton_order, Adjacency, Neighborhoods};
 use crate::{Error, Result};
 
 use crate::geometry::surface::signed_distance;
@@ -178,6 +179,27 @@ fn segment_ordered(
     params: &SegmentParams,
     pp: &PointParams,
 ) -> Result<PointSegmentation> {
+    check_point_params(params, pp)?;
+    let t = Instant::now();
+    let nbrs = knn(points, neighbours_needed(pp, normals.is_some()))?;
+    let knn_seconds = t.elapsed().as_secs_f64();
+    segment_points_with(points, &nbrs, normals, params, pp).map(|mut seg| {
+        seg.timings.insert(0, ("knn", knn_seconds));
+        seg
+    })
+}
+
+/// The neighbour count the point path reads: `pp.k` for the graph, and `pp.normal_k` for the
+/// PCA normals when none are given.
+pub fn neighbours_needed(pp: &PointParams, normals_given: bool) -> usize {
+    if normals_given {
+        pp.k
+    } else {
+        pp.k.max(pp.normal_k)
+    }
+}
+
+fn check_point_params(params: &SegmentParams, pp: &PointParams) -> Result<()> {
     check_params(params)?;
     if pp.k < 3 || pp.normal_k < 3 {
         return Err(Error::InvalidArgument(format!(
@@ -185,23 +207,109 @@ fn segment_ordered(
             pp.k, pp.normal_k
         )));
     }
-    if let Some(n) = normals {
-        if n.len() != points.len() {
-            return Err(Error::InvalidArgument(format!(
-                "point segmentation: {} normals for {} points",
-                n.len(),
-                points.len()
-            )));
+    Ok(())
+}
+
+/// The normals the point path estimates when none are given: weighted-PCA normals over the
+/// `pp.normal_k` nearest neighbours, oriented consistently over the graph of the
+/// [`neighbours_needed`] nearest (the prefixes of `nbrs`, which may hold more).
+///
+/// Errors: `nbrs` shorter than [`neighbours_needed`] or of another length than `points`.
+pub fn estimated_normals(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    pp: &PointParams,
+) -> Result<Vec<Point3>> {
+    let pca = pca_normals(
+        points,
+        nbrs,
+        &PcaParams {
+            k: pp.normal_k,
+            ..Default::default()
+        },
+    )?;
+    orient_normals_k(points, &pca.normals, nbrs, neighbours_needed(pp, false))
+}
+
+/// [`segment_points`] from precomputed neighbour lists (at least [`neighbours_needed`] per row,
+/// nearest first; longer rows are read through their prefixes), on the points in the order
+/// given (the caller chooses it: [`segment_points`] sorts along the Morton curve first).
+///
+/// Errors: as [`segment_points`], and neighbour lists too short or of another length.
+pub fn segment_points_with(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    normals: Option<&[Point3]>,
+    params: &SegmentParams,
+    pp: &PointParams,
+) -> Result<PointSegmentation> {
+    check_point_params(params, pp)?;
+    let t = Instant::now();
+    let vnormal: Vec<Point3> = match normals {
+        Some(given) => {
+            if given.len() != points.len() {
+                return Err(Error::InvalidArgument(format!(
+                    "point segmentation: {} normals for {} points",
+                    given.len(),
+                    points.len()
+                )));
+            }
+            given
+                .iter()
+                .enumerate()
+                .map(|(i, &v)| {
+                    normalize(v).ok_or_else(|| {
+                        Error::InvalidInput(format!(
+                            "point segmentation: normal {i} is zero or not finite"
+                        ))
+                    })
+                })
+                .collect::<Result<_>>()?
         }
+        None => {
+            check_neighbours(points, nbrs, neighbours_needed(pp, false))?;
+            estimated_normals(points, nbrs, pp)?
+        }
+    };
+    let normal_seconds = t.elapsed().as_secs_f64();
+    let mut seg = segment_core(points, nbrs, &vnormal, normals.is_some(), params, pp)?;
+    seg.timings.insert(1, ("normals", normal_seconds));
+    Ok(seg)
+}
+
+fn check_neighbours(points: &[Point3], nbrs: &Neighborhoods, k: usize) -> Result<()> {
+    if nbrs.len() != points.len() || nbrs.k() < k {
+        return Err(Error::InvalidArgument(format!(
+            "point segmentation: {} neighbour lists of k = {} for {} points (k >= {k} needed)",
+            nbrs.len(),
+            nbrs.k(),
+            points.len()
+        )));
+    }
+    Ok(())
+}
+
+/// The point path after the neighbours and normals: `vnormal` are unit normals, one per point
+/// (`normals_given` is reported), `nbrs` holds at least `pp.k` neighbours per row.
+pub(crate) fn segment_core(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    vnormal: &[Point3],
+    normals_given: bool,
+    params: &SegmentParams,
+    pp: &PointParams,
+) -> Result<PointSegmentation> {
+    check_point_params(params, pp)?;
+    check_neighbours(points, nbrs, pp.k)?;
+    if vnormal.len() != points.len() {
+        return Err(Error::InvalidArgument(format!(
+            "point segmentation: {} normals for {} points",
+            vnormal.len(),
+            points.len()
+        )));
     }
     let mut timings = Vec::new();
     let t = Instant::now();
-    let kq = if normals.is_some() {
-        pp.k
-    } else {
-        pp.k.max(pp.normal_k)
-    };
-    let nbrs = knn(points, kq)?;
     let n = points.len();
     // The graph: the first k of every row, symmetrised.
     let prefix = {
@@ -250,35 +358,7 @@ fn segment_ordered(
         .map(|b| b.diagonal())
         .filter(|d| *d > 0.0)
         .ok_or_else(|| Error::InvalidInput("point segmentation: the cloud has no extent".into()))?;
-    timings.push(("neighbours", t.elapsed().as_secs_f64()));
-
-    let t = Instant::now();
-    let vnormal: Vec<Point3> = match normals {
-        Some(given) => given
-            .iter()
-            .enumerate()
-            .map(|(i, &v)| {
-                normalize(v).ok_or_else(|| {
-                    Error::InvalidInput(format!(
-                        "point segmentation: normal {i} is zero or not finite"
-                    ))
-                })
-            })
-            .collect::<Result<_>>()?,
-        None => {
-            let pca = pca_normals(
-                points,
-                &nbrs,
-                &PcaParams {
-                    k: pp.normal_k,
-                    ..Default::default()
-                },
-            )?;
-            orient_normals(points, &pca.normals, &nbrs)?
-        }
-    };
-    drop(nbrs);
-    timings.push(("normals", t.elapsed().as_secs_f64()));
+    timings.push(("graph", t.elapsed().as_secs_f64()));
 
     let t = Instant::now();
     // Crease points: a graph neighbour whose normal turns faster than the crease angle per
@@ -301,7 +381,7 @@ fn segment_ordered(
         patch: pp.patch,
         ..params.bezier
     };
-    let bez = two_pass_curvature(&graph, points, &vnormal, l, &bparams, Some(&forced))?;
+    let bez = two_pass_curvature(&graph, points, vnormal, l, &bparams, Some(&forced))?;
     timings.push(("curvature", t.elapsed().as_secs_f64()));
     let weight: Vec<f64> = point_area
         .iter()
@@ -317,7 +397,7 @@ fn segment_ordered(
         &GraphInput {
             graph: &graph,
             pos: points,
-            vnormal: &vnormal,
+            vnormal,
             bez: &bez,
             weight: &weight,
             no_residual: &forced,
@@ -398,7 +478,7 @@ fn segment_ordered(
         seeds: core.seeds,
         mean_edge: l,
         epsilon: core.epsilon,
-        normals_given: normals.is_some(),
+        normals_given,
         groups,
         timings,
     })

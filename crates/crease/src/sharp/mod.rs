@@ -111,20 +111,24 @@
 
 pub mod face;
 mod measures;
-pub mod noise;
 pub mod potts;
 mod rim;
 pub mod surfaces;
 mod thin;
 
+pub use crate::estimate::noise;
 pub use measures::Measure;
 pub use potts::Regularize;
 pub use surfaces::{SurfaceRefine, SurfaceReport};
 
+use std::borrow::Cow;
+
 use rayon::prelude::*;
 
+use crate::analysis::CloudAnalysis;
 use crate::estimate::normals::{mesh_vertex_normals, PcaWeight, Weighting};
 use crate::geometry::{MeshTopology, Point3, TriMesh};
+use crate::segment::{segment_points, PointParams, PointSegmentation, SegmentParams};
 use crate::spatial::mesh_rings::vertex_k_rings_layered;
 use crate::spatial::{knn, morton_order, Neighborhoods};
 use crate::threshold::{otsu, OtsuParams};
@@ -326,10 +330,48 @@ pub fn detect_points(points: &[Point3], params: &SharpParams) -> Result<SharpRes
 }
 
 /// [`detect_points`] from precomputed k-nearest-neighbour lists (at least the largest scale).
+/// The surface stage ([`SharpParams::surfaces`]) segments `points` with the default settings.
 pub fn detect_points_with(
     points: &[Point3],
     nbrs: &Neighborhoods,
     params: &SharpParams,
+) -> Result<SharpResult> {
+    detect_core(points, nbrs, None, params, || {
+        segment_points(
+            points,
+            None,
+            &SegmentParams::default(),
+            &PointParams::default(),
+        )
+        .map(Cow::Owned)
+    })
+}
+
+/// Sharp feature points from a shared analysis of the cloud: its neighbour lists, measured noise
+/// and segmentation into analytic surfaces are read, never recomputed. The result is in the
+/// input order of the cloud.
+///
+/// Errors: the analysis' neighbour lists shorter than the largest scale (build the analysis
+/// with [`crate::analysis::AnalysisParams::max_k`] at least that), invalid parameters, and the
+/// segmentation's errors when the surface stage runs.
+pub fn detect(analysis: &CloudAnalysis, params: &SharpParams) -> Result<SharpResult> {
+    let nbrs = analysis.neighbours()?;
+    let ratio = analysis.noise_ratio()?;
+    detect_core(analysis.points(), nbrs, Some(ratio), params, || {
+        analysis.segmentation().map(Cow::Borrowed)
+    })?
+    .to_input_order(analysis.order())
+}
+
+/// The cloud detector on `points` with their neighbour lists; `ratio` the measured noise ratio
+/// (measured here when `None`); `segmentation` gives the cloud's segmentation, in the order of
+/// `points`, when the surface stage needs it.
+fn detect_core<'s>(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    ratio: Option<f64>,
+    params: &SharpParams,
+    segmentation: impl FnOnce() -> Result<Cow<'s, PointSegmentation>>,
 ) -> Result<SharpResult> {
     let scales = params
         .scales
@@ -355,7 +397,7 @@ pub fn detect_points_with(
             "mean curvature needs k >= 5 (a quadric has 6 coefficients), got scales {scales:?}"
         )));
     }
-    let ratio = noise::noise_ratio(points, nbrs);
+    let ratio = ratio.unwrap_or_else(|| noise::noise_ratio(points, nbrs));
     let per_scale: Vec<Vec<f64>> = if matches!(
         params.measure,
         Measure::ProjectedDistance | Measure::SurfaceVariation
@@ -456,14 +498,19 @@ pub fn detect_points_with(
             k: sp.k.min(nbrs.k()),
             ..sp.clone()
         };
-        r.surfaces = Some(surfaces::refine(
+        let start = std::time::Instant::now();
+        let seg = segmentation()?;
+        let mut report = surfaces::refine_with(
             points,
             nbrs,
+            &seg,
             noisy,
             &sp,
             &mut r.sharp,
             &mut r.sharpness,
-        )?);
+        )?;
+        report.seconds = start.elapsed().as_secs_f64();
+        r.surfaces = Some(report);
     }
     Ok(r)
 }

@@ -76,7 +76,7 @@ use rayon::prelude::*;
 
 use crate::geometry::surface::{signed_distance, surface_normal};
 use crate::geometry::{vec3, Point3};
-use crate::segment::{segment_points, PointParams, SegmentParams};
+use crate::segment::{segment_points, PointParams, PointSegmentation, SegmentParams};
 use crate::spatial::KdIndex;
 use crate::spatial::Neighborhoods;
 use crate::{Error, Result};
@@ -140,7 +140,8 @@ pub struct SurfaceReport {
 }
 
 /// Replaces, in place, the decisions and sharpness of the explained points (see the module
-/// documentation). `noisy`: whether the cloud was measured noisy.
+/// documentation), segmenting `points` with the default settings first. `noisy`: whether the
+/// cloud was measured noisy.
 ///
 /// Errors: lengths that differ, fewer than `k` neighbours in `nbrs`, invalid parameters, and
 /// the segmentation's errors.
@@ -152,6 +153,26 @@ pub fn refine(
     sharp: &mut [bool],
     sharpness: &mut [f64],
 ) -> Result<SurfaceReport> {
+    check_refine(points, nbrs, params, sharp, sharpness)?;
+    let start = std::time::Instant::now();
+    let seg = segment_points(
+        points,
+        None,
+        &SegmentParams::default(),
+        &PointParams::default(),
+    )?;
+    let mut report = refine_with(points, nbrs, &seg, noisy, params, sharp, sharpness)?;
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+fn check_refine(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    params: &SurfaceRefine,
+    sharp: &[bool],
+    sharpness: &[f64],
+) -> Result<()> {
     let n = points.len();
     if sharp.len() != n || sharpness.len() != n || nbrs.len() != n {
         return Err(Error::InvalidArgument(format!(
@@ -181,13 +202,33 @@ pub fn refine(
             )));
         }
     }
+    Ok(())
+}
+
+/// [`refine`] with the cloud's segmentation into analytic surfaces given (`seg`, per point in the
+/// order of `points`), e.g. the one of a shared [`crate::analysis::CloudAnalysis`]. The report's
+/// seconds are those of the decisions.
+///
+/// Errors: as [`refine`], and a segmentation of another number of points.
+pub fn refine_with(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    seg: &PointSegmentation,
+    noisy: bool,
+    params: &SurfaceRefine,
+    sharp: &mut [bool],
+    sharpness: &mut [f64],
+) -> Result<SurfaceReport> {
+    check_refine(points, nbrs, params, sharp, sharpness)?;
+    let n = points.len();
+    let k = params.k;
+    if seg.point_surface.len() != n {
+        return Err(Error::InvalidArgument(format!(
+            "sharp surfaces: a segmentation of {} points for {n} points",
+            seg.point_surface.len()
+        )));
+    }
     let start = std::time::Instant::now();
-    let seg = segment_points(
-        points,
-        None,
-        &SegmentParams::default(),
-        &PointParams::default(),
-    )?;
     let owner = &seg.point_surface;
     // Local spacing: the side of the square each point stands for, from the area of the disc
     // through its k-th neighbour, sqrt(π r_k² / (k + 1)).

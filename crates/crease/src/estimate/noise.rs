@@ -1,5 +1,6 @@
-//! The noise level of a cloud, measured from the data, which decides whether the detector's
-//! per-point decisions are regularised (see [`super::SharpParams::auto_regularize`]).
+//! The noise level of a cloud, measured from the data, which decides whether the sharp-point
+//! detector's per-point decisions are regularised (see
+//! [`crate::sharp::SharpParams::auto_regularize`]).
 //!
 //! Tran et al. note that their method "depends on the level of noise of the captured data"
 //! (section 4.5) and that 4–5 % noise already contaminates the result (section 4.4), but give no

@@ -1,0 +1,339 @@
+//! `crease run IN -o DIR`: the whole job in one command, every stage reading one shared
+//! analysis of the input (`crease::analysis`).
+//!
+//! A point cloud gets its sharp points, its curve network (sharp and fillet lines) and its
+//! analytic surfaces from one neighbour query and one segmentation; a triangle mesh gets its
+//! feature edges (the default `fused` method), their polylines and its segmentation into
+//! surfaces. DIR receives:
+//!
+//! | file | cloud | mesh |
+//! |---|---|---|
+//! | `labels.ply` | the points with `sharp`, `sharpness`, `surface`, `surface_type`, `fillet_label`, `smooth_edge` (input order) | the mesh with per-face `surface`, `surface_type` and an `edge` element with `sharp`, `sharpness` |
+//! | `network.obj` | sharp and fillet polylines (OBJ groups `sharp`, `smooth`) | the feature-edge polylines (group `sharp`) |
+//! | `surfaces.json` | the surfaces with their parameters | the same |
+//! | `summary.json` | counts, per-stage times, how often each shared piece was computed | the same |
+//! | `picture.png` | the points coloured by surface, the network on top | the mesh coloured by surface, the edges on top |
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use clap::Args;
+use crease::analysis::{AnalysisParams, CloudAnalysis};
+use crease::fillets::{curve_network, extract_fillets_from, FilletParams, Label};
+use crease::geometry::{names, Attribute, MeshTopology, PointCloud, ScalarKind, TriMesh};
+use crease::io::Geometry;
+use crease::meshfeat::{detect_edges, feature_polylines, EdgeParams};
+use crease::render::{ColorBy, Polyline, RenderParams, Scene};
+use crease::segment::{segment_mesh, SegmentParams, SegmentSurface};
+use crease::sharp::{detect, SharpParams};
+
+use crate::args::Global;
+use crate::ui::{usage, Stage};
+
+/// Arguments of `crease run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Point cloud or triangle mesh (any supported format; a file with faces is a mesh).
+    pub input: PathBuf,
+    /// Output folder (created if missing; files in it with the names above are replaced).
+    #[arg(short, long, value_name = "DIR")]
+    pub output: PathBuf,
+    /// Do not draw `picture.png`.
+    #[arg(long)]
+    pub no_picture: bool,
+    /// Write text instead of binary PLY.
+    #[arg(long)]
+    pub ascii: bool,
+}
+
+/// The colour of sharp lines in the picture.
+const SHARP_COLOR: [u8; 3] = [220, 30, 30];
+/// The colour of smooth (fillet) lines in the picture.
+const SMOOTH_COLOR: [u8; 3] = [30, 90, 220];
+
+pub fn run(g: &Global, a: &RunArgs) -> anyhow::Result<()> {
+    // The folder is made (or found unwritable) before any computation.
+    if a.output.exists() && !a.output.is_dir() {
+        return Err(usage(format!(
+            "{}: exists and is not a folder; `crease run` writes several files into a folder",
+            a.output.display()
+        )));
+    }
+    std::fs::create_dir_all(&a.output)
+        .with_context(|| format!("cannot create the output folder {}", a.output.display()))?;
+    for name in [
+        "labels.ply",
+        "network.obj",
+        "surfaces.json",
+        "summary.json",
+        "picture.png",
+    ] {
+        crate::ui::ensure_not_input(&a.output.join(name), &[&a.input])?;
+    }
+    let start = Instant::now();
+    let (geom, report) = super::load(g, &a.input)?;
+    let mut summary = if geom.is_mesh() {
+        run_mesh(g, a, geom)?
+    } else {
+        run_cloud(g, a, geom)?
+    };
+    summary["input"] = serde_json::json!(a.input);
+    summary["output"] = serde_json::json!(a.output);
+    summary["dropped_nonfinite"] = serde_json::json!(report.dropped_nonfinite);
+    summary["seconds"] = serde_json::json!(start.elapsed().as_secs_f64());
+    write_json(&a.output.join("summary.json"), &summary)?;
+    if g.json {
+        crate::ui::print_json(&summary)?;
+    } else if !g.quiet {
+        eprintln!(
+            "wrote {}: {} in {:.2} s",
+            a.output.display(),
+            summary["line"].as_str().unwrap_or_default(),
+            start.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
+/// The cloud path: one analysis, then sharp points, the curve network and the surfaces.
+fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_json::Value> {
+    let name = a.input.display().to_string();
+    let mut timings = serde_json::Map::new();
+    let mut timed = |label: &str, stage: Stage| {
+        timings.insert(label.to_string(), serde_json::json!(stage.finish()));
+    };
+    let points = &geom.points.positions;
+    let analysis =
+        CloudAnalysis::new(points, AnalysisParams::default()).with_context(|| name.clone())?;
+
+    let s = Stage::start("neighbours", g.quiet);
+    analysis.neighbours().with_context(|| name.clone())?;
+    timed("neighbours", s);
+    let s = Stage::start("segmentation into analytic surfaces", g.quiet);
+    let seg = analysis.segmentation().with_context(|| name.clone())?;
+    timed("segmentation", s);
+    let s = Stage::start("sharp points", g.quiet);
+    let sharp = detect(&analysis, &SharpParams::default()).with_context(|| name.clone())?;
+    timed("sharp_points", s);
+    let s = Stage::start("curve network (sharp + fillet lines)", g.quiet);
+    let fillets = extract_fillets_from(&analysis, &FilletParams::default(), true)
+        .with_context(|| name.clone())?;
+    let network = curve_network(&fillets);
+    timed("curve_network", s);
+
+    let surface = analysis.to_input_order(&seg.point_surface);
+    let types = analysis.to_input_order(&seg.point_types());
+    let mut cloud = geom.points.clone();
+    cloud.set_attribute(Attribute::flag(names::SHARP, sharp.sharp.iter().copied()))?;
+    cloud.set_attribute(Attribute::float(names::SHARPNESS, sharp.sharpness.clone()))?;
+    cloud.set_attribute(Attribute::int(
+        names::SURFACE,
+        surface.iter().map(|&s| i64::from(s)),
+    ))?;
+    cloud.set_attribute(uchar(names::SURFACE_TYPE, types.iter().copied()))?;
+    cloud.set_attribute(uchar(
+        names::FILLET_LABEL,
+        fillets.label.iter().map(|l| l.map_or(255, |l| l as u8)),
+    ))?;
+    cloud.set_attribute(Attribute::flag(
+        names::SMOOTH_EDGE,
+        fillets.label.iter().map(|&l| l == Some(Label::Border)),
+    ))?;
+    let labels = Geometry::from_cloud(cloud);
+    super::save(
+        g,
+        &a.output.join("labels.ply"),
+        &labels,
+        a.ascii,
+        &[&a.input],
+    )?;
+
+    let mut net = Geometry::from_cloud(PointCloud::from_positions(network.vertices.clone()));
+    net.polylines = network.polylines.clone();
+    net.polyline_groups = network
+        .smooth
+        .iter()
+        .map(|&s| if s { names::SMOOTH } else { names::SHARP }.to_string())
+        .collect();
+    super::save(g, &a.output.join("network.obj"), &net, false, &[&a.input])?;
+    write_surfaces(&a.output, &seg.surfaces, &seg.groups, seg.mean_edge)?;
+
+    let sharp_lines = network.smooth.iter().filter(|&&s| !s).count();
+    let smooth_lines = network.polylines.len() - sharp_lines;
+    if !a.no_picture {
+        let lines = network
+            .polylines
+            .iter()
+            .zip(&network.smooth)
+            .map(|(l, &smooth)| picture_line(l, &network.vertices, smooth))
+            .collect();
+        picture(a, &labels, None, lines, seg.surfaces.len())?;
+    }
+    let assigned = surface.iter().filter(|&&s| s >= 0).count();
+    Ok(serde_json::json!({
+        "kind": "cloud",
+        "points": points.len(),
+        "sharp_points": sharp.num_sharp(),
+        "noise_ratio": sharp.noise_ratio,
+        "regularized": sharp.regularized,
+        "surfaces": seg.surfaces.len(),
+        "assigned_points": assigned,
+        "sharp_polylines": sharp_lines,
+        "smooth_polylines": smooth_lines,
+        "joined_smooth_ends": network.joined_ends,
+        "open_smooth_ends": network.open_ends,
+        "analysis": analysis.counts(),
+        "timings": timings,
+        "line": format!(
+            "{} sharp points, {} sharp and {} fillet polylines, {} surfaces ({} of {} points)",
+            sharp.num_sharp(), sharp_lines, smooth_lines, seg.surfaces.len(), assigned,
+            points.len()
+        ),
+    }))
+}
+
+/// The mesh path: feature edges, their polylines, the segmentation of the faces.
+fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_json::Value> {
+    let name = a.input.display().to_string();
+    let mut mesh = geom
+        .into_mesh()
+        .with_context(|| format!("{name}: faces that are not a triangle mesh"))?;
+    let mut timings = serde_json::Map::new();
+    let s = Stage::start("feature edges", g.quiet);
+    let (em, det) = detect_edges(&mesh, &EdgeParams::default()).with_context(|| name.clone())?;
+    timings.insert("feature_edges".into(), serde_json::json!(s.finish()));
+    let edges = em.topo.edges().to_vec();
+    let lines = feature_polylines(&em.topo, &det.sharp);
+    drop(em);
+    let s = Stage::start("segmentation into analytic surfaces", g.quiet);
+    let topo = MeshTopology::new(&mesh).with_context(|| name.clone())?;
+    let seg =
+        segment_mesh(&mesh, &topo, &SegmentParams::default()).with_context(|| name.clone())?;
+    drop(topo);
+    timings.insert("segmentation".into(), serde_json::json!(s.finish()));
+
+    mesh.set_face_attribute(Attribute::int(
+        names::SURFACE,
+        seg.face_surface.iter().map(|&s| i64::from(s)),
+    ))?;
+    mesh.set_face_attribute(uchar(names::SURFACE_TYPE, seg.face_types()))?;
+    let n_edges = edges.len();
+    let n_sharp = det.sharp.iter().filter(|&&s| s).count();
+    let mut out = Geometry::from_mesh(mesh);
+    out.edges = edges;
+    out.edge_attributes.insert(
+        n_edges,
+        Attribute::flag(names::SHARP, det.sharp.iter().copied()),
+    )?;
+    out.edge_attributes.insert(
+        n_edges,
+        Attribute::float(names::SHARPNESS, det.sharpness.clone()),
+    )?;
+    super::save(g, &a.output.join("labels.ply"), &out, a.ascii, &[&a.input])?;
+    let mut net = Geometry::from_cloud(PointCloud::from_positions(out.points.positions.clone()));
+    net.polylines = lines.clone();
+    net.polyline_groups = vec![names::SHARP.to_string(); lines.len()];
+    super::save(g, &a.output.join("network.obj"), &net, false, &[&a.input])?;
+    write_surfaces(&a.output, &seg.surfaces, &seg.groups, seg.mean_edge)?;
+    if !a.no_picture {
+        let drawn = lines
+            .iter()
+            .map(|l| picture_line(l, &out.points.positions, false))
+            .collect();
+        let mesh = out.clone().into_mesh().context("labelled mesh")?;
+        picture(a, &out, Some(&mesh), drawn, seg.surfaces.len())?;
+    }
+    let assigned = seg.face_surface.iter().filter(|&&s| s >= 0).count();
+    Ok(serde_json::json!({
+        "kind": "mesh",
+        "vertices": out.points.len(),
+        "faces": out.faces.len(),
+        "edges": n_edges,
+        "sharp_edges": n_sharp,
+        "sharp_polylines": lines.len(),
+        "surfaces": seg.surfaces.len(),
+        "assigned_faces": assigned,
+        "timings": timings,
+        "line": format!(
+            "{n_sharp} of {n_edges} edges sharp in {} polylines, {} surfaces ({} of {} faces)",
+            lines.len(), seg.surfaces.len(), assigned, out.faces.len()
+        ),
+    }))
+}
+
+/// `surfaces.json`: the surfaces with their parameters (as `crease segment --primitives`).
+fn write_surfaces(
+    dir: &Path,
+    surfaces: &[SegmentSurface],
+    groups: &[crease::segment::recognize::Group],
+    mean_edge: f64,
+) -> anyhow::Result<()> {
+    let doc = serde_json::json!({
+        "surface_type_codes": {"plane": 0, "cylinder": 1, "cone": 2, "sphere": 3, "torus": 4, "unassigned": 255},
+        "mean_edge": mean_edge,
+        "surfaces": surfaces,
+        "groups": groups,
+    });
+    write_json(&dir.join("surfaces.json"), &doc)
+}
+
+/// Writes JSON to a temporary file beside `path`, then renames it into place.
+fn write_json(path: &Path, value: &serde_json::Value) -> anyhow::Result<()> {
+    let tmp = path.with_extension("json.part");
+    std::fs::write(&tmp, serde_json::to_string_pretty(value)? + "\n")
+        .with_context(|| format!("cannot write {}", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))
+}
+
+fn picture_line(ids: &[u32], vertices: &[[f64; 3]], smooth: bool) -> Polyline {
+    let closed = ids.len() > 2 && ids.first() == ids.last();
+    let ids = if closed { &ids[..ids.len() - 1] } else { ids };
+    Polyline {
+        points: ids.iter().map(|&v| vertices[v as usize]).collect(),
+        closed,
+        color: if smooth { SMOOTH_COLOR } else { SHARP_COLOR },
+        label: Some(if smooth { "fillet line" } else { "sharp line" }.to_string()),
+    }
+}
+
+/// `picture.png`: coloured by surface id (each surface its own colour), lines on top.
+fn picture(
+    a: &RunArgs,
+    labels: &Geometry,
+    mesh: Option<&TriMesh>,
+    polylines: Vec<Polyline>,
+    surfaces: usize,
+) -> anyhow::Result<()> {
+    let path = a.output.join("picture.png");
+    let params = RenderParams {
+        color_by: ColorBy::Attribute(names::SURFACE.into()),
+        title: Some(format!(
+            "{}: {surfaces} surfaces",
+            a.input
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        )),
+        ..Default::default()
+    };
+    let scene = Scene {
+        mesh,
+        points: if mesh.is_some() {
+            None
+        } else {
+            Some(&labels.points)
+        },
+        polylines,
+    };
+    crease::render::render_png(&scene, &params, &path)
+        .with_context(|| format!("cannot draw {}", path.display()))
+}
+
+fn uchar(name: &str, values: impl IntoIterator<Item = u8>) -> Attribute {
+    Attribute {
+        name: name.to_string(),
+        kind: ScalarKind::U8,
+        values: values.into_iter().map(f64::from).collect(),
+    }
+}

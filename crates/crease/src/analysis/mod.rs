@@ -1,0 +1,241 @@
+//! The analysis of one point cloud, computed once and shared by every stage.
+//!
+//! Every detector of crease stands on the same few things: the points in a cache-friendly
+//! order, their k nearest neighbours, normals, the measured noise and the segmentation into
+//! analytic surfaces. A [`CloudAnalysis`] holds them, each computed lazily on first use and at
+//! most once, and the stages read them:
+//!
+//! | piece | computed by | read by |
+//! |---|---|---|
+//! | Morton order | [`crate::spatial::morton_order`] | every stage (they run on the sorted points) |
+//! | neighbour lists, k = [`AnalysisParams::max_k`] | [`crate::spatial::knn`] | sharp points (all scales are prefixes), noise, normals, segmentation, 1-rings |
+//! | noise ratio | [`crate::estimate::noise::noise_ratio`] | sharp points (Potts switch, surface bands) |
+//! | normals (PCA, oriented) | [`crate::segment::estimated_normals`] | segmentation, outputs |
+//! | segmentation | [`crate::segment`] (point path) | sharp points' surface stage, outputs |
+//!
+//! One neighbour query at the largest k serves every smaller k: rows are nearest first with
+//! ties broken by index, so a prefix of a row is exactly the smaller query's row. The stages
+//! that take an analysis (`sharp::detect`, `lines::extract_lines_from`,
+//! `fillets::extract_fillets_from`) give results in the cloud's input order. The line
+//! pipelines' first-order structure (Delaunay 1-rings of the first `LinesParams::k`
+//! neighbours, region growing) is theirs: `fillets::extract_fillets_from` with the sharp lines
+//! builds it once for the whole curve network. [`CloudAnalysis::counts`] tells how often each piece was
+//! computed (once at most: a test holds the whole `crease run` to it).
+//!
+//! The pieces are computed on first use, one at a time, on the calling thread's rayon pool;
+//! an analysis is `Sync`, but a piece asked for by two threads at once may be computed twice
+//! (both results are identical; one is kept).
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
+
+use rayon::prelude::*;
+
+use crate::estimate::noise::noise_ratio;
+use crate::geometry::Point3;
+use crate::segment::{
+    estimated_normals, neighbours_needed, segment_core, PointParams, PointSegmentation,
+    SegmentParams,
+};
+use crate::spatial::{knn, morton_order, Neighborhoods};
+use crate::{Error, Result};
+
+/// The default neighbour count of the one query: the largest scale of
+/// [`crate::sharp::CLOUD_SCALES`] (tran section 4.2).
+pub const DEFAULT_MAX_K: usize = 40;
+
+/// Settings of the shared pieces. The defaults are those of each stage's paper (see
+/// [`crate::sharp`], [`crate::segment`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AnalysisParams {
+    /// Neighbours per point of the one neighbour query (default [`DEFAULT_MAX_K`]); every
+    /// stage's k must be at most this.
+    pub max_k: usize,
+    /// Segmentation thresholds.
+    pub segment: SegmentParams,
+    /// Segmentation: the point path's neighbour counts and patch model.
+    pub points: PointParams,
+}
+
+impl Default for AnalysisParams {
+    fn default() -> Self {
+        AnalysisParams {
+            max_k: DEFAULT_MAX_K,
+            segment: SegmentParams::default(),
+            points: PointParams::default(),
+        }
+    }
+}
+
+/// How many times each piece was computed (each is 0 or 1 unless asked for concurrently).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub struct AnalysisCounts {
+    /// Neighbour queries.
+    pub neighbours: usize,
+    /// Normal estimations.
+    pub normals: usize,
+    /// Noise measurements.
+    pub noise: usize,
+    /// Segmentations into analytic surfaces.
+    pub segmentations: usize,
+}
+
+#[derive(Debug, Default)]
+struct Counters {
+    neighbours: AtomicUsize,
+    normals: AtomicUsize,
+    noise: AtomicUsize,
+    segmentations: AtomicUsize,
+}
+
+/// The shared analysis of one point cloud (see the module documentation). The points are held
+/// in Morton order: `points()[r]` is input point `order()[r]`; per-point pieces follow that
+/// order, and the stages map their results back to the input order.
+#[derive(Debug)]
+pub struct CloudAnalysis {
+    params: AnalysisParams,
+    order: Vec<u32>,
+    points: Vec<Point3>,
+    neighbours: OnceLock<Neighborhoods>,
+    noise: OnceLock<f64>,
+    normals: OnceLock<Vec<Point3>>,
+    segmentation: OnceLock<PointSegmentation>,
+    counters: Counters,
+}
+
+impl CloudAnalysis {
+    /// An analysis of `points` (input order) with the given settings; nothing is computed yet
+    /// but the spatial order.
+    ///
+    /// Errors: fewer than `max_k + 1` points, a non-finite coordinate, a `max_k` smaller than
+    /// the segmentation's neighbour counts.
+    pub fn new(points: &[Point3], params: AnalysisParams) -> Result<CloudAnalysis> {
+        let need = neighbours_needed(&params.points, false);
+        if params.max_k < need {
+            return Err(Error::InvalidArgument(format!(
+                "analysis: max_k = {} is smaller than the {need} neighbours the segmentation reads",
+                params.max_k
+            )));
+        }
+        if points.len() <= params.max_k {
+            return Err(Error::InvalidInput(format!(
+                "{} points: the analysis needs at least {} (its neighbourhoods hold {} points)",
+                points.len(),
+                params.max_k + 1,
+                params.max_k
+            )));
+        }
+        crate::spatial::knn::check_finite(points)?;
+        let order = morton_order(points);
+        if order.len() != points.len() {
+            return Err(Error::InvalidInput(
+                "analysis: the points have no spatial order (a non-finite coordinate)".into(),
+            ));
+        }
+        let sorted = order.par_iter().map(|&i| points[i as usize]).collect();
+        Ok(CloudAnalysis {
+            params,
+            order,
+            points: sorted,
+            neighbours: OnceLock::new(),
+            noise: OnceLock::new(),
+            normals: OnceLock::new(),
+            segmentation: OnceLock::new(),
+            counters: Counters::default(),
+        })
+    }
+
+    /// The settings.
+    pub fn params(&self) -> &AnalysisParams {
+        &self.params
+    }
+
+    /// The points in Morton order.
+    pub fn points(&self) -> &[Point3] {
+        &self.points
+    }
+
+    /// `order()[r]` is the input index of sorted point r.
+    pub fn order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// Per-point values in the analysis' (sorted) order, put back into the input order.
+    pub fn to_input_order<T: Copy + Default + Send + Sync>(&self, sorted: &[T]) -> Vec<T> {
+        let mut out = vec![T::default(); sorted.len()];
+        for (r, &i) in self.order.iter().enumerate() {
+            out[i as usize] = sorted[r];
+        }
+        out
+    }
+
+    /// The `max_k` nearest neighbours of every (sorted) point, nearest first.
+    pub fn neighbours(&self) -> Result<&Neighborhoods> {
+        once(&self.neighbours, &self.counters.neighbours, || {
+            knn(&self.points, self.params.max_k)
+        })
+    }
+
+    /// The noise ratio of [`crate::estimate::noise::noise_ratio`].
+    pub fn noise_ratio(&self) -> Result<f64> {
+        let nbrs = self.neighbours()?;
+        once(&self.noise, &self.counters.noise, || {
+            Ok(noise_ratio(&self.points, nbrs))
+        })
+        .copied()
+    }
+
+    /// Consistently oriented PCA normals of the (sorted) points, as the segmentation estimates
+    /// them ([`crate::segment::estimated_normals`]).
+    pub fn normals(&self) -> Result<&[Point3]> {
+        let nbrs = self.neighbours()?;
+        once(&self.normals, &self.counters.normals, || {
+            estimated_normals(&self.points, nbrs, &self.params.points)
+        })
+        .map(Vec::as_slice)
+    }
+
+    /// The segmentation of the (sorted) points into analytic surfaces.
+    pub fn segmentation(&self) -> Result<&PointSegmentation> {
+        if let Some(s) = self.segmentation.get() {
+            return Ok(s);
+        }
+        let nbrs = self.neighbours()?;
+        let normals = self.normals()?;
+        once(&self.segmentation, &self.counters.segmentations, || {
+            segment_core(
+                &self.points,
+                nbrs,
+                normals,
+                false,
+                &self.params.segment,
+                &self.params.points,
+            )
+        })
+    }
+
+    /// How many times each piece was computed so far.
+    pub fn counts(&self) -> AnalysisCounts {
+        let c = &self.counters;
+        AnalysisCounts {
+            neighbours: c.neighbours.load(Ordering::Relaxed),
+            normals: c.normals.load(Ordering::Relaxed),
+            noise: c.noise.load(Ordering::Relaxed),
+            segmentations: c.segmentations.load(Ordering::Relaxed),
+        }
+    }
+}
+
+/// The cell's value, computing it (and counting the computation) on first use.
+fn once<'a, T>(
+    cell: &'a OnceLock<T>,
+    counter: &AtomicUsize,
+    compute: impl FnOnce() -> Result<T>,
+) -> Result<&'a T> {
+    if let Some(v) = cell.get() {
+        return Ok(v);
+    }
+    let v = compute()?;
+    counter.fetch_add(1, Ordering::Relaxed);
+    Ok(cell.get_or_init(|| v))
+}
