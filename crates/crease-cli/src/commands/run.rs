@@ -185,6 +185,8 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
         "open_smooth_ends": network.open_ends,
         "analysis": analysis.counts(),
         "timings": timings,
+        "segmentation_stages": seg.timings.iter().map(|(k, v)| (k.to_string(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+        "sharp_surface_stage": sharp.surfaces,
         "line": format!(
             "{} sharp points, {} sharp and {} fillet polylines, {} surfaces ({} of {} points)",
             sharp.num_sharp(), sharp_lines, smooth_lines, seg.surfaces.len(), assigned,

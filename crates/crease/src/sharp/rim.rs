@@ -25,7 +25,6 @@
 
 use crate::geometry::fit_plane;
 use crate::geometry::{vec3, Point3};
-use crate::spatial::KdIndex;
 
 /// ρ(u) of the module documentation: a unit disc cut at x ≤ u, the ratio of its centroid's
 /// distance from the disc's centre to its RMS radius about the centroid.
@@ -71,20 +70,12 @@ pub(crate) fn distance_fraction(ratio: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// The distance from point `i` to the rim of its sheet (length units), from the plane through
-/// it and its `k` nearest neighbours (see the module documentation), and the RMS distance of
-/// those points to the plane; `None` when the fit fails.
-pub(crate) fn rim_distance(
-    points: &[Point3],
-    index: &KdIndex,
-    i: usize,
-    k: usize,
-) -> Option<(f64, f64)> {
-    let p = points[i];
-    // The nearest item is the point itself (distance 0), so k + 1 items.
-    let near = index.nearest(&p, k + 1);
-    let radius = near.last().map(|&(_, d2)| d2.sqrt())?;
-    let plane = fit_plane(near.iter().map(|&(j, _)| (points[j as usize], 1.0)))?;
+/// The distance from point `p` to the rim of its sheet (length units), from the plane through
+/// it and its nearest neighbours `near` (see the module documentation; `radius` is the distance
+/// to the farthest of them), and the RMS distance of those points to the plane; `None` when the
+/// fit fails.
+pub(crate) fn rim_distance(p: Point3, near: &[Point3], radius: f64) -> Option<(f64, f64)> {
+    let plane = fit_plane(std::iter::once((p, 1.0)).chain(near.iter().map(|&q| (q, 1.0))))?;
     let d = vec3::sub(plane.centroid, p);
     let along = vec3::sub(d, vec3::scale(plane.normal, vec3::dot(d, plane.normal)));
     let rms = (plane.eigenvalues[1] + plane.eigenvalues[2]).sqrt();
@@ -158,7 +149,14 @@ mod tests {
                 }
             }
         }
-        let index = KdIndex::new(&pts).expect("index");
+        let index = crate::spatial::KdIndex::new(&pts).expect("index");
+        let at = |i: usize| {
+            // The point itself is the nearest item: its 80 neighbours follow.
+            let near = index.nearest(&pts[i], 81);
+            let radius = near.last().expect("neighbours").1.sqrt();
+            let others: Vec<Point3> = near[1..].iter().map(|&(j, _)| pts[j as usize]).collect();
+            rim_distance(pts[i], &others, radius).expect("fit").0
+        };
         let mut worst = 0.0f64;
         for (i, p) in pts.iter().enumerate() {
             let truth = p[0]
@@ -168,14 +166,14 @@ mod tests {
             if !(1.0..=2.0).contains(&truth) || (p[0] - p[1]).abs() < 4.0 {
                 continue;
             }
-            let s = rim_distance(&pts, &index, i, 80).expect("fit").0;
+            let s = at(i);
             worst = worst.max((s - truth).abs());
         }
         assert!(worst < 1.0, "worst error {worst}");
         // Deep inside: the distance saturates near the neighbourhood's radius (3.6 spacings here,
         // measured 2.9 with the sampling's jitter).
         let centre = (side / 2) * side * 2 + side;
-        let s = rim_distance(&pts, &index, centre, 80).expect("fit").0;
+        let s = at(centre);
         assert!(s > 2.5, "{s}");
     }
 }

@@ -77,8 +77,7 @@ use rayon::prelude::*;
 use crate::geometry::surface::{signed_distance, surface_normal};
 use crate::geometry::{vec3, Point3};
 use crate::segment::{segment_points, PointParams, PointSegmentation, SegmentParams};
-use crate::spatial::KdIndex;
-use crate::spatial::Neighborhoods;
+use crate::spatial::{knn_map_set, Neighborhoods};
 use crate::{Error, Result};
 
 /// Parameters of the surface stage ([`super::SharpParams::surfaces`]).
@@ -350,13 +349,15 @@ pub fn refine_with(
     // neighbours) are decided by the distance to a sheet's rim (see the module documentation).
     let mut rim = 0;
     if noisy && params.rim_k > 0 && n > params.rim_k {
-        let index = KdIndex::new(points).ok_or_else(|| {
-            Error::InvalidArgument("sharp surfaces: no k-d tree over the points".into())
-        })?;
-        let rim_decided: Vec<Option<(bool, f64)>> = (0..n)
-            .into_par_iter()
-            .with_min_len(64)
-            .map(|i| {
+        // Most points of a noisy cloud need their rim distance (every point of a face with no
+        // second surface near it), so the neighbourhoods of rim_k points come from one pass of
+        // the grid search over all points, each used while in cache.
+        let rim_decided: Vec<Option<(bool, f64)>> = knn_map_set(
+            points,
+            params.rim_k,
+            || (),
+            |_, q| {
+                let i = q.index;
                 let row = nbrs.prefix(i, k);
                 let unassigned = row.iter().filter(|&&j| owner[j as usize] < 0).count();
                 let segmented = owner[i] >= 0 && 2 * unassigned <= row.len();
@@ -364,15 +365,16 @@ pub fn refine_with(
                 if segmented && !no_pair {
                     return None;
                 }
-                let (s, rms) = super::rim::rim_distance(points, &index, i, params.rim_k)?;
+                let radius = q.dist2.iter().copied().fold(0.0, f64::max).sqrt();
+                let (s, rms) = super::rim::rim_distance(q.point, q.neighbors, radius)?;
                 // A point the segmentation explains is a rim point only where its neighbourhood
                 // is one flat sheet within the noise.
                 if segmented && rms > params.rim_flatness * sigma * h[i] {
                     return None;
                 }
                 Some(band_decision((params.rim_band + sigma) * h[i], s))
-            })
-            .collect();
+            },
+        )?;
         for (i, d) in rim_decided.into_iter().enumerate() {
             if let Some((label, s)) = d {
                 if edge[i].is_some() {
