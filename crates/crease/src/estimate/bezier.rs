@@ -57,7 +57,6 @@ use rayon::prelude::*;
 use super::curvature::{least_axis, monge_curvature, Curvature, Derivatives, PointCurvature};
 use crate::geometry::vec3::{add, cross, dist, dist2, dot, normalize, scale, sub};
 use crate::geometry::{MeshTopology, Point3, TriMesh};
-use crate::spatial::mesh_rings::VertexSet;
 use crate::spatial::Adjacency;
 use crate::{Error, Result};
 
@@ -328,9 +327,43 @@ fn vertex_normals(mesh: &TriMesh, topo: &MeshTopology) -> Vec<Point3> {
 /// Per-thread scratch of a pass.
 #[derive(Default)]
 struct Scratch {
-    set: VertexSet,
+    /// `mark[u] == stamp`: vertex u is in the current region. A stamp per query instead of a
+    /// hash set of the region: the membership test is one load (measured on 1M cloud points,
+    /// the two passes 4.2 -> 3.0 s with identical output; the hash set's probing was a fifth
+    /// of the segmentation's time).
+    /// Allocated zeroed on first use; only the pages a task's Morton-local queries touch are
+    /// ever written.
+    mark: Vec<u32>,
+    stamp: u32,
     region: Vec<u32>,
     local: Vec<Point3>,
+}
+
+impl Scratch {
+    /// Starts a new region over `n` vertices: no vertex marked.
+    fn next_region(&mut self, n: usize) {
+        if self.mark.len() != n {
+            self.mark = vec![0; n];
+            self.stamp = 0;
+        }
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.mark.iter_mut().for_each(|m| *m = 0);
+            self.stamp = 1;
+        }
+    }
+
+    /// Marks `u`; true if it was not marked in this region yet.
+    #[inline]
+    fn insert(&mut self, u: u32) -> bool {
+        let m = &mut self.mark[u as usize];
+        if *m == self.stamp {
+            false
+        } else {
+            *m = self.stamp;
+            true
+        }
+    }
 }
 
 fn fit_pass<G: Adjacency>(
@@ -390,23 +423,22 @@ fn fit_vertex<G: Adjacency>(
         return PointCurvature::FAILED;
     }
     let r2 = (width * l_avg).powi(2);
-    s.set.clear();
+    s.next_region(p.len());
     s.region.clear();
-    s.set.insert(v as u32);
+    s.insert(v as u32);
     s.region.push(v as u32);
     let mut head = 0;
     while head < s.region.len() {
         let u = s.region[head] as usize;
         head += 1;
-        let (set, region) = (&mut s.set, &mut s.region);
+        let (mark, stamp, region) = (&mut s.mark, s.stamp, &mut s.region);
         graph.for_each_neighbor(u, |w| {
             let wi = w as usize;
-            if excluded.is_some_and(|e| e[wi]) || dist2(p[wi], pv) >= r2 {
+            if mark[wi] == stamp || excluded.is_some_and(|e| e[wi]) || dist2(p[wi], pv) >= r2 {
                 return;
             }
-            if set.insert(w) {
-                region.push(w);
-            }
+            mark[wi] = stamp;
+            region.push(w);
         });
     }
     if s.region.len() < 6 {
