@@ -262,3 +262,47 @@ pub fn surface_normal(s: &SurfaceParams, p: Point3) -> Point3 {
         }
     }
 }
+
+/// A surface with its per-surface constants computed once (the cone's sine and cosine of its
+/// half angle), for loops over many points: [`Prepared::signed_distance`] equals
+/// [`signed_distance`] bit for bit. Measured on a 9.7k-point scan (`scans/curvsurf`), the
+/// per-point `sin_cos` of the cone's distance was half the segmentation's time, in the
+/// Levenberg–Marquardt refinements that evaluate every residual 2N + 1 times an iteration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prepared {
+    surface: SurfaceParams,
+    sin: f64,
+    cos: f64,
+}
+
+impl Prepared {
+    /// Prepares `surface`.
+    pub fn new(surface: &SurfaceParams) -> Prepared {
+        let (sin, cos) = match *surface {
+            SurfaceParams::Cone { half_angle, .. } => half_angle.sin_cos(),
+            _ => (0.0, 1.0),
+        };
+        Prepared {
+            surface: *surface,
+            sin,
+            cos,
+        }
+    }
+
+    /// The surface.
+    pub fn surface(&self) -> &SurfaceParams {
+        &self.surface
+    }
+
+    /// [`signed_distance`] from `p`.
+    #[inline]
+    pub fn signed_distance(&self, p: Point3) -> f64 {
+        match self.surface {
+            SurfaceParams::Cone { apex, axis_dir, .. } => {
+                let [rho, h] = meridian(p, apex, axis_dir);
+                rho * self.cos - h * self.sin
+            }
+            ref s => signed_distance(s, p),
+        }
+    }
+}

@@ -42,7 +42,7 @@
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector3};
 use rayon::prelude::*;
 
-use crate::geometry::surface::{meridian, signed_distance};
+use crate::geometry::surface::{meridian, signed_distance, Prepared};
 use crate::geometry::vec3::{add, cross, dist2, dot, norm, normalize, scale, sub};
 use crate::geometry::{Point3, SurfaceParams, SurfaceType};
 
@@ -715,7 +715,7 @@ fn lm<const N: usize>(
     surf: impl Fn(&[f64; N]) -> SurfaceParams + Sync,
 ) -> Option<[f64; N]> {
     let cost = |x: &[f64; N]| -> f64 {
-        let s = surf(x);
+        let s = Prepared::new(&surf(x));
         let parts: Vec<f64> = pts
             .par_chunks(2048)
             .zip(w.par_chunks(2048))
@@ -723,7 +723,7 @@ fn lm<const N: usize>(
                 p.iter()
                     .zip(w)
                     .map(|(&p, &w)| {
-                        let d = signed_distance(&s, p);
+                        let d = s.signed_distance(p);
                         w * d * d
                     })
                     .sum::<f64>()
@@ -732,7 +732,7 @@ fn lm<const N: usize>(
         parts.into_iter().sum()
     };
     let normal_eq = |x: &[f64; N]| -> (SMatrix<f64, N, N>, SVector<f64, N>) {
-        let base = surf(x);
+        let base = Prepared::new(&surf(x));
         let mut plus = Vec::with_capacity(N);
         let mut minus = Vec::with_capacity(N);
         let mut steps = [0.0; N];
@@ -741,10 +741,10 @@ fn lm<const N: usize>(
             steps[j] = h;
             let mut xp = *x;
             xp[j] += h;
-            plus.push(surf(&xp));
+            plus.push(Prepared::new(&surf(&xp)));
             let mut xm = *x;
             xm[j] -= h;
-            minus.push(surf(&xm));
+            minus.push(Prepared::new(&surf(&xm)));
         }
         let parts: Vec<(SMatrix<f64, N, N>, SVector<f64, N>)> = pts
             .par_chunks(2048)
@@ -753,10 +753,10 @@ fn lm<const N: usize>(
                 let mut jtj = SMatrix::<f64, N, N>::zeros();
                 let mut jtr = SVector::<f64, N>::zeros();
                 for (&p, &wi) in p.iter().zip(w) {
-                    let r = signed_distance(&base, p);
+                    let r = base.signed_distance(p);
                     let mut g = SVector::<f64, N>::zeros();
                     for j in 0..N {
-                        g[j] = (signed_distance(&plus[j], p) - signed_distance(&minus[j], p))
+                        g[j] = (plus[j].signed_distance(p) - minus[j].signed_distance(p))
                             / (2.0 * steps[j]);
                     }
                     jtj += g * g.transpose() * wi;
