@@ -9,13 +9,15 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// The operating system refused to open, read or write a file.
-    #[error("{path}: {source}")]
+    ///
+    /// The message already holds the operating system's words, so the underlying error is not
+    /// also chained as a `source` (a chain printer would say it twice).
+    #[error("{path}: {error}")]
     Io {
         /// The file concerned.
         path: PathBuf,
         /// The underlying error.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file's content does not follow its format.
     #[error("{path}: {message}")]
@@ -64,7 +66,7 @@ impl Error {
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),
-            source,
+            error: source,
         }
     }
 }

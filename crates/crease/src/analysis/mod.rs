@@ -8,7 +8,7 @@
 //! | piece | computed by | read by |
 //! |---|---|---|
 //! | Morton order | [`crate::spatial::morton_order`] | every stage (they run on the sorted points) |
-//! | neighbour lists, k = [`AnalysisParams::max_k`] | [`crate::spatial::knn`] | sharp points (all scales are prefixes), noise, normals, segmentation, 1-rings |
+//! | neighbour lists, k = [`AnalysisParams::max_k`] | [`crate::spatial::knn()`] | sharp points (all scales are prefixes), noise, normals, segmentation, 1-rings |
 //! | noise ratio | [`crate::estimate::noise::noise_ratio`] | sharp points (Potts switch, surface bands) |
 //! | normals (PCA, oriented) | [`crate::segment::estimated_normals`] | segmentation, outputs |
 //! | segmentation | [`crate::segment`] (point path) | sharp points' surface stage, outputs |

@@ -1,5 +1,5 @@
 //! Two-pass biquadratic Bézier curvature of triangle meshes (mizoguchi section 3, after Razdan
-//! and Bae's biquadratic Bézier patch fit, mizoguchi reference [2]).
+//! and Bae's biquadratic Bézier patch fit, mizoguchi reference \[2\]).
 //!
 //! **Fit region (mizoguchi equation 1).** For vertex `v_i` the fit uses `v_i` and the vertices
 //! "directly connected to `v_i`" among those with `‖v_j − v_i‖ < W · l_i,avg`, `l_i,avg` being

@@ -1,12 +1,12 @@
 //! Principal curvatures of point clouds from a quadric fitted over the k nearest neighbours in a
 //! local frame (demarsin2008 section 2.1: "to compute the mean curvature in p, we fit a quadric
-//! through the k nearest neighbors of p, as described in e.g. [18]" — Petitjean's survey of
+//! through the k nearest neighbors of p, as described in e.g. \[18\]" — Petitjean's survey of
 //! quadric fitting), plus the Monge-patch curvature formulas shared with the Bézier fit of
 //! [`super::bezier`].
 //!
 //! Per point `p` with neighbours `N(p)` (the first `k` of its kNN row):
 //! 1. The least-squares plane of `{p} ∪ N(p)` (its normal is the eigenvector of the smallest
-//!    eigenvalue of the covariance, as in [`super::fit_plane`], computed here in closed form) gives
+//!    eigenvalue of the covariance, as in [`crate::geometry::fit_plane`], computed here in closed form) gives
 //!    an orthonormal frame `(e1, e2, n)`; the frame's origin is `p` itself.
 //! 2. In that frame (coordinates scaled by the neighbourhood radius for conditioning) the height
 //!    function `z = a x² + b xy + c y² + d x + e y + f` is fitted by linear least squares
@@ -162,7 +162,7 @@ impl Default for QuadricParams {
 /// unoriented normals: each point's normal is oriented so that its mean curvature is ≥ 0.
 ///
 /// Inputs: `points` (`N`), `nbrs` their kNN lists (`N` rows, nearest first, e.g. from
-/// [`crate::spatial::knn`]), `params`.
+/// [`crate::spatial::knn()`]), `params`.
 /// Output: `N` estimates in input order, identical whatever the thread count.
 /// Errors: `nbrs` does not have `N` rows, or `params.k < 5`.
 pub fn quadric_curvature(

@@ -1,5 +1,5 @@
 //! The 1-ring normal of demarsin2007 section 2.2: "the normal in p is estimated as the normal of
-//! the least squares plane through the 1-ring neighborhood of p" (citing [15]), with the 1-ring
+//! the least squares plane through the 1-ring neighborhood of p" (citing \[15\]), with the 1-ring
 //! the Delaunay neighbourhood of [`crate::spatial::delaunay_rings`]. Because the ring holds only
 //! the few points around p, the normal changes over a much narrower band at a sharp edge than a
 //! k-nearest-neighbour (PCA) normal, which is what the paper's region growing relies on.

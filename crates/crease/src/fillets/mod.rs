@@ -12,7 +12,7 @@
 //! 2. **Per region**: optional Laplacian smoothing (section 2.4; crease uses Taubin's λ|μ
 //!    variant, which does not shrink the fillets whose curvature is being measured), then the
 //!    mean curvature |H| of a quadric fitted over the k nearest neighbours *within the region*
-//!    ([`crate::estimate::quadric_curvature`], section 2.1). Restricting the neighbours to the
+//!    ([`crate::estimate::curvature::quadric_curvature`], section 2.1). Restricting the neighbours to the
 //!    region is what section 1.2 buys: the points beside a sharp edge do not see the other
 //!    face, so they keep the curvature of their own patch.
 //! 3. **Thresholds** ([`histogram`], section 2.2): the highest `trim` fraction of the values is

@@ -1,7 +1,7 @@
 //! Exact minimisation of binary energies by one minimum s-t cut.
 //!
 //! * [`maxflow`]: the Boykov–Kolmogorov max-flow / min-cut algorithm ([`Graph`]).
-//! * [`potts`]: binary energies with submodular pairwise terms (Kolmogorov & Zabih, "What
+//! * [`mod@potts`]: binary energies with submodular pairwise terms (Kolmogorov & Zabih, "What
 //!   energy functions can be minimized via graph cuts?", PAMI 2004), among them the
 //!   Potts / Ising model Σ D_i(x_i) + λ Σ w_ij [x_i ≠ x_j] of vidal et al. 2011 (equation 1),
 //!   over an edge list or a CSR neighbour graph.

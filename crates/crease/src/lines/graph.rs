@@ -487,14 +487,14 @@ fn along_line(clusters: &Clusters, g: &Graph, p: u32, q: u32) -> bool {
 /// - N holds the `n` nearest vertices that may be linked: no path of at most `d` edges to p,
 ///   within `2 n h` of p (h: the median edge length of the graph; the paper's n nearest span
 ///   about n h along a line, the bound doubles it), and ahead of the branch: within 60° of its
-///   direction ([`end_direction`]; fragments shorter than 3 edges have none and look all
+///   direction (`end_direction`; fragments shorter than 3 edges have none and look all
 ///   ways), unless closer than 2 h (a line that ends on the side of another, as fillet borders
 ///   end on their region's boundary).
 /// - Case 1 for all endpoints together: endpoint pairs that are in each other's N are linked,
 ///   nearest pairs first; this repeats, since joined fragments gain a direction; then pairs
 ///   with one end in the other's N.
 /// - Case 2 for the endpoints left: the nearest vertex of N that had more than one edge before
-///   the closing, unless the link runs along the line through that vertex ([`along_line`]: a
+///   the closing, unless the link runs along the line through that vertex (`along_line`: a
 ///   spur beside its own feature) or closes a cycle of at most `2 d` edges (the two ends of a
 ///   gap linking past each other to the opposite sides).
 ///

@@ -396,7 +396,7 @@ pub struct EdgeParams {
     pub filter_iterations: usize,
     /// Total-variation normal filtering, averaged with the bilateral angle ([`tv`]).
     pub tv: TvParams,
-    /// Smoothing of the filtered angle along the lines ([`line`]).
+    /// Smoothing of the filtered angle along the lines ([`mod@line`]).
     pub line: LineParams,
     /// Threshold of `filtered`, and the decision angle of `potts-filtered`, degrees (default
     /// [`FILTERED_DEGREES`]).
@@ -611,7 +611,7 @@ pub fn detect_prepared(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetecti
 /// 93.7 lose), measured against the last iteration alone with range factor 1.5, the earlier
 /// default. Clean meshes: 99.99 % → 100.00 %.
 ///
-/// **The line smoothing** (added 2026-12-03, see [`line`]): 99.15 → 99.62 % at 0.2 %, 98.63 →
+/// **The line smoothing** (added 2026-12-03, see [`mod@line`]): 99.15 → 99.62 % at 0.2 %, 98.63 →
 /// 98.80 % at 0.5 %, clean 100.00 %.
 ///
 /// **The total-variation half** (added 2026-12-03, measured with `examples/meshfeat_table2.rs`,

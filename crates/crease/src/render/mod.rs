@@ -5,8 +5,8 @@
 //! top, side), each with its name and a small axis triad, all at the same scale so that sizes
 //! compare, plus a legend on the right and an optional title on top.
 //!
-//! * Cameras are orthographic, fitted to the scene's bounding box ([`camera`]).
-//! * Each view is rasterised into its own z-buffer ([`raster`]); views are drawn in parallel.
+//! * Cameras are orthographic, fitted to the scene's bounding box (module `camera`).
+//! * Each view is rasterised into its own z-buffer (module `raster`); views are drawn in parallel.
 //!   Points are discs facing the camera (size chosen from the point count and the image size
 //!   unless given), triangles are flat-shaded (Gouraud when the mesh has vertex normals) with a
 //!   camera-mounted light (Lambert + ambient).

@@ -61,7 +61,7 @@
 //! surfaces. At the powers of two 2^10 and 2^-10 all were the same bit for bit.
 //!
 //! Surface-type codes (PLY `surface_type`, uchar) are those of
-//! [`SurfaceType`](crate::geometry::SurfaceType): plane 0, cylinder 1, cone 2, sphere 3, torus 4,
+//! [`crate::geometry::SurfaceType`]: plane 0, cylinder 1, cone 2, sphere 3, torus 4,
 //! 255 unassigned.
 
 pub mod fit;

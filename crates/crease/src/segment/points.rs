@@ -1,6 +1,6 @@
 //! Segmentation of a point cloud into analytic surfaces: mizoguchi's pipeline "over
 //! k-nearest-neighbour graphs with the quadric-fit curvature" (issue 7), sharing every stage
-//! after the curvature with the mesh path ([`super::segment_graph`]).
+//! after the curvature with the mesh path (`segment_graph`).
 //!
 //! **Graph.** The mesh edges are replaced by the symmetrised k-nearest-neighbour graph
 //! (`k = 8` by default, [`PointParams::k`]; an edge i–j when j is among the k nearest of i or

@@ -10,12 +10,12 @@
 //! the 12 to 40 nearest), the neighbourhood's centroid lies between the faces and every point of
 //! the plate looks sharp. This module drops those neighbours before the measure is taken.
 //!
-//! **The test.** Every point gets a small-scale normal m_i ([`face_normals`]): the PCA normal of
+//! **The test.** Every point gets a small-scale normal m_i (`face_normals`): the PCA normal of
 //! the point and its [`FACE_K`] nearest neighbours (few enough that the opposite face is rarely
 //! among them), refitted [`FACE_REFITS`] times over those of its [`FACE_K_REFIT`] nearest whose
 //! chord q − p makes at most [`CHORD_DEG`] with the current plane (which drops the opposite face
 //! and the far side of an edge from the fit). Neighbour j of point i is on another sheet
-//! ([`other_sheet`]) when
+//! (`SheetTest::other_sheet`) when
 //! * the two normals are parallel, |m_i·m_j| ≥ cos [`PARALLEL_DEG`], and
 //! * the chord leaves both tangent planes by more than [`CHORD_DEG`]:
 //!   |d·m_i| > sin(β)‖d‖ and |d·m_j| > sin(β)‖d‖, d = p_j − p_i.
@@ -54,15 +54,15 @@ use crate::geometry::plane::Moments;
 use crate::geometry::{vec3, Point3};
 use crate::spatial::Neighborhoods;
 
-/// Neighbours of the first small-scale fit of [`face_normals`].
+/// Neighbours of the first small-scale fit of `face_normals`.
 pub const FACE_K: usize = 6;
-/// Neighbours among which the refits of [`face_normals`] choose.
+/// Neighbours among which the refits of `face_normals` choose.
 pub const FACE_K_REFIT: usize = 12;
-/// Number of refits of [`face_normals`].
+/// Number of refits of `face_normals`.
 pub const FACE_REFITS: usize = 2;
-/// Normals at most this far apart (degrees) are parallel in [`other_sheet`].
+/// Normals at most this far apart (degrees) are parallel in `SheetTest::other_sheet`.
 pub const PARALLEL_DEG: f64 = 20.0;
-/// A chord further than this (degrees) from a tangent plane leaves it ([`other_sheet`], refits).
+/// A chord further than this (degrees) from a tangent plane leaves it (`SheetTest::other_sheet`, refits).
 pub const CHORD_DEG: f64 = 15.0;
 
 /// Uniform covariance of `p` and the points of `q` (moments about `p`), whose smallest

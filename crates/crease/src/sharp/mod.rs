@@ -46,7 +46,7 @@
 //!   cloud samples as sharp edges, 1100 of the 1241 detections); on the plates (7010, 7038) the
 //!   truth labels both edges of rims 1.3–1.8 spacings wide, which the thinning reduces to one
 //!   line (7038 unthinned: 0.59 with exact normals, thinned 0.48); the thinning now compares
-//!   only points displaced to the same side ([`thin`]), which keeps both edges: median 0.784
+//!   only points displaced to the same side (module `thin`), which keeps both edges: median 0.784
 //!   (0133 0.924, 6944 0.684, 7010 0.643, 7023 0.947, 7029 0.940, 7031 0.196, 7034 0.885, 7038
 //!   0.458; noisy 0.231: 0133 0.410, 6944 0.111, 7023 0.383, 7029 0.382, the others
 //!   unchanged). On 6944 stage 2 costs 0.03 (0.716 without it: it drops a parallel sheet about
@@ -57,7 +57,7 @@
 //!   chord test drops neighbours at random (median 0.231 → 0.205), hence it is off where
 //!   the cloud is measured noisy ([`noise::NOISY_RATIO`]), and the noisy figures are unchanged.
 //! * [`SharpParams::thin`]: detections are thinned across the line to one or two points,
-//!   comparing (clouds) only neighbours displaced to the same side, see [`thin`].
+//!   comparing (clouds) only neighbours displaced to the same side, see the module `thin`.
 //! * [`SharpParams::density_invariant`]: the projected distance is a length, so on an unevenly
 //!   sampled scan a single threshold flags the sparse regions first (tran section 4.5 names
 //!   this limitation). Dividing it by the RMS radius of the neighbourhood makes it a
@@ -65,7 +65,7 @@
 //!   the neighbourhood's size, identical for any sampling density. Mean curvature is likewise
 //!   multiplied by the radius. On by default.
 //! * [`SharpParams::otsu`]: the histogram's top can be a high quantile instead of the maximum
-//!   (see [`crate::threshold::otsu`]); a few outliers otherwise squeeze all points into the
+//!   (see [`crate::threshold::otsu()`]); a few outliers otherwise squeeze all points into the
 //!   first bins.
 //! * [`SharpParams::auto_regularize`] (clouds): tran's method "depends on the level of noise"
 //!   (section 4.5) and degrades from 4–5 % noise on (section 4.4). The noise is measured from the
@@ -88,7 +88,7 @@
 //!   0.653, 6944 0.111 → 0.394, 7023 0.383 → 0.593, 7029 0.382 → 0.531, 7031 0.052 → 0.134;
 //!   the thin plates 7034 and 7038, where the segmentation fails, keep the detector's labels).
 //!   On noisy clouds the points of thin sheets are then decided by their distance to the
-//!   sheet's rim ([`rim`], from the in-plane offset of the centroid of 80 neighbours, see
+//!   sheet's rim (module `rim`, from the in-plane offset of the centroid of 80 neighbours, see
 //!   [`surfaces`] step 6): noisy median 0.332 → 0.462 (7034 0.228 → 0.562, 7038 −0.002 →
 //!   0.396, 7023 0.593 → 0.631, 7010 0.271 → 0.289, 6944 0.394 → 0.377, 7029 0.531 → 0.527,
 //!   0133 0.653 → 0.656, 7031 0.134 → 0.135); clean unchanged (0.812). With the segmentation's
@@ -174,7 +174,7 @@ pub struct SharpParams {
     /// point's own (the opposite face of a thin plate, the facing wall of a slot), see
     /// [`face`]. Default true. Only for the projected distance and the surface variation.
     pub one_face: bool,
-    /// Thin the detections to lines one or two points wide (see [`thin`]); default true.
+    /// Thin the detections to lines one or two points wide (see the module `thin`); default true.
     pub thin: bool,
     /// Replace the per-point decisions by the Potts labelling of the kNN graph of
     /// [`potts`] (before thinning; point clouds only). Default `None`: measured on the

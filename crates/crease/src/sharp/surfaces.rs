@@ -38,7 +38,7 @@
 //!    (2 b_i < h_i). The other explained points are not sharp (sharpness b_i / e(i) < 1,
 //!    0 without a pair); the points not explained keep the detector's decision and sharpness;
 //! 6. noisy clouds only, thin sheets: a point is decided by its distance s(i) to the rim of its
-//!    sheet ([`super::rim`], over its [`SurfaceRefine::rim_k`] nearest points) when it or more
+//!    sheet (module `rim`, over its [`SurfaceRefine::rim_k`] nearest points) when it or more
 //!    than half of its k neighbours are unassigned, or when step 4 found no pair and the plane
 //!    through those rim_k points fits them within [`SurfaceRefine::rim_flatness`] σ h_i (RMS);
 //!    it is sharp when s(i) < r_i = ([`SurfaceRefine::rim_band`] + σ) h_i, sharpness r_i / s(i).
@@ -94,7 +94,7 @@ pub struct SurfaceRefine {
     /// A point is explained by its surface within this many noise σ (default 3).
     pub trust: f64,
     /// Noisy clouds: neighbours of the plane whose in-plane centroid offset gives the distance
-    /// to a sheet's rim ([`super::rim`]), default 80 (twice the largest scale, since a sheet's
+    /// to a sheet's rim (module `rim`), default 80 (twice the largest scale, since a sheet's
     /// neighbourhood holds both of its faces).
     pub rim_k: usize,
     /// Noisy clouds: half-width of the rim band, in spacings, before the noise σ is added

@@ -1,5 +1,5 @@
 //! Vertex adjacency shared by meshes and point clouds: the mesh edges of a
-//! [`MeshTopology`](crate::geometry::MeshTopology), or an undirected neighbour graph stored as
+//! [`crate::geometry::MeshTopology`], or an undirected neighbour graph stored as
 //! [`Csr`] rows (e.g. the symmetrised k-nearest-neighbour graph of a cloud,
 //! [`Csr::symmetrized`]). Algorithms written over [`Adjacency`] (k-rings, the Bézier / quadric
 //! fit regions of `estimate::bezier`, the seeds and region growing of `segment`) run unchanged

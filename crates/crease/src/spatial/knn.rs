@@ -48,7 +48,7 @@
 //!   of 3 in one process: 0.468 s (PCL `NormalEstimationOMP` 1.745 s in the same run of
 //!   `scripts/compare-normals.sh`, 2026-12-02), random input order 0.662 s (PCL 3.74 s); peak
 //!   memory of `crease normals` 116 MB. The day before: 0.587 s (PCL 1.65 s), before the
-//!   subsampled k-th distance estimate, the radix cell sort ([`cell_sorted`]) and the batched
+//!   subsampled k-th distance estimate, the radix cell sort (`cell_sorted`) and the batched
 //!   eigen solves. On an earlier day, slower machine: the shell search 1.17 s, the first block
 //!   search 0.95 s (PCL 2.34 s).
 //! * Instructions per query (callgrind, 100k points, one thread): the shell search ≈ 7000 for

@@ -1,7 +1,7 @@
 //! Morton (Z-order) codes of 3D points: 21 bits per axis, quantised over the bounding box.
 //!
 //! Sorting points by their code puts points that are close in space close in memory, which is
-//! what makes the all-points queries of [`super::knn`] cache friendly whatever the input order.
+//! what makes the all-points queries of [`super::knn()`] cache friendly whatever the input order.
 
 use rayon::prelude::*;
 

@@ -1,6 +1,6 @@
 //! Radius search for every point of a cloud, and k nearest neighbours capped by a radius.
 //!
-//! Same machinery as [`super::knn`]: a Morton sort, a uniform grid whose cell side is a power of
+//! Same machinery as [`super::knn()`]: a Morton sort, a uniform grid whose cell side is a power of
 //! two of quantisation units close to the radius, queries in Morton order, rows gathered back to
 //! the input order. "Within r" means a squared distance `dx² + dy² + dz² ≤ r·r` evaluated in
 //! f64; rows are sorted by distance then input index and exclude the point itself (but keep its

@@ -2,7 +2,7 @@
 //! projected-distance threshold automatically (section 3.2, equation 4).
 //!
 //! The scores are normalised to [0, 1] (tran section 3.2: "every projected distance is
-//! normalized between [0,1]"), binned into a histogram, and the bin boundary that maximises the
+//! normalized between \[0,1\]"), binned into a histogram, and the bin boundary that maximises the
 //! between-class variance ω₀ω₁(μ₀ − μ₁)² is the threshold T; a value is in the upper class when
 //! it is ≥ T (equation 4). The paper does not give the number of bins: 256, the usual grey-level
 //! count of Otsu's method, is the default.
