@@ -81,26 +81,9 @@ pub struct FilletsArgs {
 }
 
 fn params(a: &FilletsArgs) -> anyhow::Result<FilletParams> {
-    if !(a.alpha_max > 0.0 && a.alpha_max < 90.0) {
-        return Err(usage(format!(
-            "--alpha-max must be in (0, 90) degrees, got {}",
-            a.alpha_max
-        )));
-    }
-    if a.k < 3 || a.d_max == 0 || a.curvature_k < 5 || a.bins < 4 {
-        return Err(usage(
-            "-k must be at least 3, --curvature-k at least 5, --bins at least 4 and --d-max positive"
-                .to_string(),
-        ));
-    }
-    if !(0.0..0.5).contains(&a.trim) {
-        return Err(usage(format!("--trim must be in [0, 0.5), got {}", a.trim)));
-    }
     let thresholds = if !a.tau.is_empty() {
-        if a.tau.iter().any(|t| !t.is_finite() || *t < 0.0) {
-            return Err(usage(
-                "--tau values must be non-negative numbers".to_string(),
-            ));
+        if a.tau.iter().any(|t| *t < 0.0) {
+            return Err(usage("--tau values must be non-negative".to_string()));
         }
         ThresholdCount::Manual(a.tau.clone())
     } else if a.thresholds == "auto" {
@@ -118,7 +101,7 @@ fn params(a: &FilletsArgs) -> anyhow::Result<FilletParams> {
             }
         }
     };
-    Ok(FilletParams {
+    let params = FilletParams {
         lines: LinesParams {
             k: a.k,
             alpha_max_degrees: a.alpha_max,
@@ -139,7 +122,9 @@ fn params(a: &FilletsArgs) -> anyhow::Result<FilletParams> {
         thresholds,
         coarse_retry: a.coarse_retry,
         ..Default::default()
-    })
+    };
+    params.validate().map_err(|e| usage(e.to_string()))?;
+    Ok(params)
 }
 
 /// `crease fillets` (`network` false) and `crease network` (`network` true).

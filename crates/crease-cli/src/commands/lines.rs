@@ -61,27 +61,6 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
         crease::io::Format::from_path(s).map_err(|e| usage(e.to_string()))?;
         crate::ui::ensure_not_input(s, &[&a.input])?;
     }
-    if !(a.alpha_max > 0.0 && a.alpha_max < 90.0) {
-        return Err(usage(format!(
-            "--alpha-max must be in (0, 90) degrees, got {}",
-            a.alpha_max
-        )));
-    }
-    if a.k < 3 || a.d_max == 0 || a.n == Some(0) || a.d == Some(0) {
-        return Err(usage(
-            "-k must be at least 3, and --d-max, --n, --d positive".to_string(),
-        ));
-    }
-    let (geom, report) = super::load(g, &a.input)?;
-    let n_points = geom.points.len();
-    if n_points < a.k + 1 {
-        anyhow::bail!(
-            "{}: {n_points} points, sharp lines with -k {} need at least {}",
-            a.input.display(),
-            a.k,
-            a.k + 1
-        );
-    }
     let params = LinesParams {
         k: a.k,
         alpha_max_degrees: a.alpha_max,
@@ -92,6 +71,17 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
         boundary: !a.no_boundary,
         denoise_normals: !a.no_denoise,
     };
+    params.validate().map_err(|e| usage(e.to_string()))?;
+    let (geom, report) = super::load(g, &a.input)?;
+    let n_points = geom.points.len();
+    if n_points < a.k + 1 {
+        anyhow::bail!(
+            "{}: {n_points} points, sharp lines with -k {} need at least {}",
+            a.input.display(),
+            a.k,
+            a.k + 1
+        );
+    }
     let start = Instant::now();
     let stage = Stage::start("sharp lines (Demarsin 2007)", g.quiet);
     let net = extract_lines(&geom.points.positions, &params)

@@ -61,21 +61,19 @@ pub fn run(g: &Global, a: &SegmentArgs) -> anyhow::Result<()> {
     for o in &outputs {
         crate::ui::ensure_not_input(o, &[&a.input])?;
     }
-    if !(a.th_pos > 0.0 && a.th_pos.is_finite() && a.th_norm > 0.0 && a.th_norm < 90.0) {
-        return Err(usage(format!(
-            "--th-pos must be positive and --th-norm in (0, 90) degrees, got {} and {}",
-            a.th_pos, a.th_norm
-        )));
-    }
-    if a.k < 3 {
-        return Err(usage(format!("--k must be at least 3, got {}", a.k)));
-    }
-    let (mut geom, report) = super::load(g, &a.input)?;
     let params = SegmentParams {
         th_pos: a.th_pos,
         th_norm_degrees: a.th_norm,
         ..Default::default()
     };
+    params.validate().map_err(|e| usage(e.to_string()))?;
+    PointParams {
+        k: a.k,
+        ..Default::default()
+    }
+    .validate()
+    .map_err(|e| usage(e.to_string()))?;
+    let (mut geom, report) = super::load(g, &a.input)?;
     if !geom.is_mesh() {
         return run_cloud(g, a, geom, report.dropped_nonfinite, &params);
     }

@@ -86,20 +86,6 @@ impl Method {
 pub fn run(g: &Global, a: &SharpArgs) -> anyhow::Result<()> {
     crease::io::Format::from_path(&a.output).map_err(|e| usage(e.to_string()))?;
     crate::ui::ensure_not_input(&a.output, &[&a.input])?;
-    if let Some(t) = a.threshold {
-        if !(t > 0.0 && t <= 1.0) {
-            return Err(usage(format!("--threshold must be in (0, 1], got {t}")));
-        }
-    }
-    if a.scales.contains(&0) {
-        return Err(usage("--scales must be positive integers".to_string()));
-    }
-    if !(a.upper_quantile > 0.0 && a.upper_quantile <= 1.0) {
-        return Err(usage(format!(
-            "--upper-quantile must be in (0, 1], got {}",
-            a.upper_quantile
-        )));
-    }
     let mut params = SharpParams {
         measure: a.method.measure(),
         scales: (!a.scales.is_empty()).then(|| a.scales.clone()),
@@ -114,16 +100,12 @@ pub fn run(g: &Global, a: &SharpArgs) -> anyhow::Result<()> {
     }
     params.otsu.upper_quantile = a.upper_quantile;
     if let Some(lambda) = a.regularize {
-        if !(lambda.is_finite() && lambda > 0.0) {
-            return Err(usage(format!(
-                "--regularize must be a positive number, got {lambda}"
-            )));
-        }
         params.regularize = Some(crease::sharp::Regularize {
             lambda,
             ..Default::default()
         });
     }
+    params.validate().map_err(|e| usage(e.to_string()))?;
     let (mut geom, report) = super::load(g, &a.input)?;
     let n = geom.points.len();
     let on_mesh = geom.is_mesh() && !a.points_only;

@@ -67,6 +67,23 @@ impl Default for AnalysisParams {
     }
 }
 
+impl AnalysisParams {
+    /// Errors (`InvalidArgument`) on invalid segmentation settings or a `max_k` below the
+    /// neighbours the segmentation reads.
+    pub fn validate(&self) -> Result<()> {
+        self.segment.validate()?;
+        self.points.validate()?;
+        let need = neighbours_needed(&self.points, false);
+        if self.max_k < need {
+            return Err(Error::InvalidArgument(format!(
+                "analysis: max_k = {} is smaller than the {need} neighbours the segmentation reads",
+                self.max_k
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// How many times each piece was computed (each is 0 or 1 unless asked for concurrently).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct AnalysisCounts {
@@ -107,16 +124,10 @@ impl CloudAnalysis {
     /// An analysis of `points` (input order) with the given settings; nothing is computed yet
     /// but the spatial order.
     ///
-    /// Errors: fewer than `max_k + 1` points, a non-finite coordinate, a `max_k` smaller than
-    /// the segmentation's neighbour counts.
+    /// Errors: invalid settings ([`AnalysisParams::validate`]), fewer than `max_k + 1`
+    /// points, a non-finite coordinate.
     pub fn new(points: &[Point3], params: AnalysisParams) -> Result<CloudAnalysis> {
-        let need = neighbours_needed(&params.points, false);
-        if params.max_k < need {
-            return Err(Error::InvalidArgument(format!(
-                "analysis: max_k = {} is smaller than the {need} neighbours the segmentation reads",
-                params.max_k
-            )));
-        }
+        params.validate()?;
         if points.len() <= params.max_k {
             return Err(Error::InvalidInput(format!(
                 "{} points: the analysis needs at least {} (its neighbourhoods hold {} points)",

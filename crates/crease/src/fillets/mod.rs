@@ -310,7 +310,17 @@ pub struct Timing {
     pub smooth_lines: f64,
 }
 
+impl FilletParams {
+    /// Errors (`InvalidArgument`) on invalid line settings ([`LinesParams::validate`]), a
+    /// trimmed fraction outside [0, 0.5), fewer than 4 bins, a curvature k below 5, or manual
+    /// thresholds that are empty or not finite.
+    pub fn validate(&self) -> Result<()> {
+        check_params(self)
+    }
+}
+
 fn check_params(params: &FilletParams) -> Result<()> {
+    params.lines.validate()?;
     if !(0.0..0.5).contains(&params.trim) {
         return Err(Error::InvalidArgument(format!(
             "the trimmed fraction must be in [0, 0.5), got {}",

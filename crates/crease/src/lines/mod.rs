@@ -201,7 +201,20 @@ const DENOISE_SIGMA: f64 = 1.5;
 /// At most this many passes of the bilateral normal smoothing.
 const DENOISE_PASSES: usize = 6;
 
+impl LinesParams {
+    /// Errors (`InvalidArgument`) on α_max outside (0, 90) degrees, k < 3, d_max = 0, or n
+    /// or d given as 0.
+    pub fn validate(&self) -> Result<()> {
+        check_params(self)
+    }
+}
+
 fn check_params(params: &LinesParams) -> Result<()> {
+    if params.n == Some(0) || params.d == Some(0) {
+        return Err(Error::InvalidArgument(
+            "sharp lines: n and d of the connect step must be positive".into(),
+        ));
+    }
     if !(params.alpha_max_degrees > 0.0 && params.alpha_max_degrees < 90.0) {
         return Err(Error::InvalidArgument(format!(
             "alpha_max must be in (0, 90) degrees, got {}",

@@ -498,6 +498,13 @@ fn min_points(k: SurfaceType) -> usize {
 }
 
 /// Errors on thresholds outside their ranges.
+impl SegmentParams {
+    /// Errors (`InvalidArgument`) on th_pos not positive or th_norm outside (0, 90) degrees.
+    pub fn validate(&self) -> Result<()> {
+        check_params(self)
+    }
+}
+
 pub(crate) fn check_params(params: &SegmentParams) -> Result<()> {
     if !(params.th_pos > 0.0
         && params.th_pos.is_finite()

@@ -201,13 +201,20 @@ pub fn neighbours_needed(pp: &PointParams, normals_given: bool) -> usize {
 
 fn check_point_params(params: &SegmentParams, pp: &PointParams) -> Result<()> {
     check_params(params)?;
-    if pp.k < 3 || pp.normal_k < 3 {
-        return Err(Error::InvalidArgument(format!(
-            "point segmentation: k = {} and normal_k = {} must be at least 3",
-            pp.k, pp.normal_k
-        )));
+    pp.validate()
+}
+
+impl PointParams {
+    /// Errors (`InvalidArgument`) on k or normal_k below 3.
+    pub fn validate(&self) -> Result<()> {
+        if self.k < 3 || self.normal_k < 3 {
+            return Err(Error::InvalidArgument(format!(
+                "point segmentation: k = {} and normal_k = {} must be at least 3",
+                self.k, self.normal_k
+            )));
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 /// The normals the point path estimates when none are given: weighted-PCA normals over the

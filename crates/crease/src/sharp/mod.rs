@@ -213,6 +213,40 @@ impl Default for SharpParams {
     }
 }
 
+impl SharpParams {
+    /// Errors (`InvalidArgument`) on an empty or zero scale, a manual threshold outside
+    /// (0, 1], and invalid Otsu, regularisation or surface-stage settings. (Scale limits that
+    /// depend on the input, such as the largest ring of a mesh or k >= 5 for the mean
+    /// curvature of a cloud, are checked by the detectors.)
+    pub fn validate(&self) -> Result<()> {
+        if let Some(s) = &self.scales {
+            check_scales(s, "scales")?;
+        }
+        if let ThresholdRule::Manual(t) = self.threshold {
+            if !(t > 0.0 && t <= 1.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "manual sharpness threshold must be in (0, 1], got {t}"
+                )));
+            }
+        }
+        self.otsu.validate()?;
+        if let Some(r) = &self.regularize {
+            r.validate()?;
+        }
+        if let Some(s) = &self.surfaces {
+            s.validate()?;
+        }
+        if let Some(t) = self.auto_regularize {
+            if !t.is_finite() {
+                return Err(Error::InvalidArgument(format!(
+                    "auto_regularize must be finite, got {t}"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Per-thread buffers of the measure pass: gathered coordinates, work space, the end of each
 /// scale's neighbourhood in the coordinates, the running count of kept neighbours.
 type Gather = (Vec<Point3>, Vec<Point3>, Vec<usize>, Vec<usize>);
@@ -311,6 +345,7 @@ fn check_scales(scales: &[usize], what: &str) -> Result<()> {
 ///
 /// Errors: fewer points than the largest k + 1, non-finite coordinates, invalid parameters.
 pub fn detect_points(points: &[Point3], params: &SharpParams) -> Result<SharpResult> {
+    params.validate()?;
     let scales = params
         .scales
         .clone()
@@ -373,6 +408,7 @@ fn detect_core<'s>(
     params: &SharpParams,
     segmentation: impl FnOnce() -> Result<Cow<'s, PointSegmentation>>,
 ) -> Result<SharpResult> {
+    params.validate()?;
     let scales = params
         .scales
         .clone()
@@ -563,6 +599,7 @@ pub fn relabel_points(
 ///
 /// Errors: invalid parameters or a mesh whose topology cannot be built.
 pub fn detect_mesh(mesh: &TriMesh, params: &SharpParams) -> Result<SharpResult> {
+    params.validate()?;
     let scales = params
         .scales
         .clone()

@@ -84,6 +84,27 @@ impl Regularize {
     /// ([`super::SharpParams::auto_regularize`]): k = 10, λ = 1, α = 16, slope 1, the best noisy
     /// median of the table in the module documentation (0.231), chosen there before the noise
     /// switch existed (not re-tuned for it).
+    /// Errors (`InvalidArgument`) on k = 0 or a negative or non-finite weight.
+    pub fn validate(&self) -> Result<()> {
+        if self.k == 0 {
+            return Err(Error::InvalidArgument(
+                "sharp regularisation: k must be at least 1".into(),
+            ));
+        }
+        for (name, v) in [
+            ("lambda", self.lambda),
+            ("line_reward", self.line_reward),
+            ("slope", self.slope),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "sharp regularisation: {name} must be finite and >= 0, got {v}"
+                )));
+            }
+        }
+        Ok(())
+    }
+
     pub fn noisy() -> Self {
         Regularize {
             k: 10,
@@ -125,24 +146,14 @@ pub fn regularize(
             nbrs.len()
         )));
     }
+    params.validate()?;
     let k = params.k;
-    if k == 0 || k > nbrs.k() || params.k_dir > nbrs.k() {
+    if k > nbrs.k() || params.k_dir > nbrs.k() {
         return Err(Error::InvalidArgument(format!(
-            "sharp regularisation: k = {k} and k_dir = {} need 1 <= k and both <= {}",
+            "sharp regularisation: k = {k} and k_dir = {} need both <= {}",
             params.k_dir,
             nbrs.k()
         )));
-    }
-    for (name, v) in [
-        ("lambda", params.lambda),
-        ("line_reward", params.line_reward),
-        ("slope", params.slope),
-    ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(Error::InvalidArgument(format!(
-                "sharp regularisation: {name} must be finite and >= 0, got {v}"
-            )));
-        }
     }
     let log_s: Vec<f64> = sharpness
         .par_iter()

@@ -181,27 +181,41 @@ fn check_refine(
             nbrs.len()
         )));
     }
+    params.validate()?;
     let k = params.k;
-    if k == 0 || k > nbrs.k() {
+    if k > nbrs.k() {
         return Err(Error::InvalidArgument(format!(
             "sharp surfaces: k = {k} must be in 1..={}",
             nbrs.k()
         )));
     }
-    for (name, v) in [
-        ("min_angle_degrees", params.min_angle_degrees),
-        ("edge_band", params.edge_band),
-        ("trust", params.trust),
-        ("rim_band", params.rim_band),
-        ("rim_flatness", params.rim_flatness),
-    ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(Error::InvalidArgument(format!(
-                "sharp surfaces: {name} must be finite and >= 0, got {v}"
-            )));
-        }
-    }
     Ok(())
+}
+
+impl SurfaceRefine {
+    /// Errors (`InvalidArgument`) on k = 0 or a negative or non-finite band, angle or factor.
+    pub fn validate(&self) -> Result<()> {
+        let params = self;
+        if params.k == 0 {
+            return Err(Error::InvalidArgument(
+                "sharp surfaces: k must be at least 1".into(),
+            ));
+        }
+        for (name, v) in [
+            ("min_angle_degrees", params.min_angle_degrees),
+            ("edge_band", params.edge_band),
+            ("trust", params.trust),
+            ("rim_band", params.rim_band),
+            ("rim_flatness", params.rim_flatness),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "sharp surfaces: {name} must be finite and >= 0, got {v}"
+                )));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// [`refine`] with the cloud's segmentation into analytic surfaces given (`seg`, per point in the

@@ -32,6 +32,25 @@ pub struct OtsuParams {
     pub upper_quantile: f64,
 }
 
+impl OtsuParams {
+    /// Errors (`InvalidArgument`) on fewer than 2 bins or an upper quantile outside (0, 1].
+    pub fn validate(&self) -> Result<()> {
+        if self.bins < 2 {
+            return Err(Error::InvalidArgument(format!(
+                "Otsu threshold with {} histogram bins (at least 2)",
+                self.bins
+            )));
+        }
+        let q = self.upper_quantile;
+        if !(q > 0.0 && q <= 1.0) {
+            return Err(Error::InvalidArgument(format!(
+                "Otsu threshold: upper quantile must be in (0, 1], got {q}"
+            )));
+        }
+        Ok(())
+    }
+}
+
 impl Default for OtsuParams {
     fn default() -> Self {
         OtsuParams {
@@ -65,18 +84,8 @@ pub struct Otsu {
 /// all values are equal there is no split: the threshold is just above them (no value in the
 /// upper class) and `between_variance` is 0.
 pub fn otsu(values: &[f64], params: &OtsuParams) -> Result<Otsu> {
-    if params.bins < 2 {
-        return Err(Error::InvalidArgument(format!(
-            "Otsu threshold with {} histogram bins (at least 2)",
-            params.bins
-        )));
-    }
+    params.validate()?;
     let q = params.upper_quantile;
-    if !(q > 0.0 && q <= 1.0) {
-        return Err(Error::InvalidArgument(format!(
-            "Otsu threshold: upper quantile must be in (0, 1], got {q}"
-        )));
-    }
     if values.is_empty() {
         return Err(Error::InvalidArgument(
             "Otsu threshold of an empty set of values".into(),
