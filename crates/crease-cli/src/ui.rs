@@ -91,8 +91,27 @@ impl Stage {
     }
 }
 
-/// Refuses to write `output` if it is one of the `inputs` (never overwrite the input file).
+/// Refuses to write `output` if it is one of the `inputs` (never overwrite the input file), or
+/// if its folder does not exist or `output` is a folder: every command checks its outputs so
+/// before it reads or computes anything.
 pub fn ensure_not_input(output: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
+    let parent = output
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        anyhow::bail!(
+            "{}: the folder {} does not exist; create it first",
+            output.display(),
+            parent.display()
+        );
+    }
+    if output.is_dir() {
+        anyhow::bail!(
+            "{}: is a folder; give a file name to write",
+            output.display()
+        );
+    }
     let out = canonical(output);
     for inp in inputs {
         if canonical(inp) == out {

@@ -565,3 +565,36 @@ fn run_refuses_a_file_as_its_output_folder() {
         .code(2)
         .stderr(predicates::str::contains("not a folder"));
 }
+
+#[test]
+fn a_missing_output_folder_is_reported_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = common::synth(dir.path(), &["synth", "cube", "-n", "2000"], "cube.ply");
+    for cmd in [
+        "sharp",
+        "normals",
+        "segment",
+        "network",
+        "lines",
+        "curvature",
+    ] {
+        let out = dir.path().join("no/such/folder/out.ply");
+        let o = crease()
+            .arg(cmd)
+            .arg(&input)
+            .arg("-o")
+            .arg(&out)
+            .arg("-v")
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{cmd}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("does not exist"), "{cmd}: {err}");
+        // Nothing was read: the reading stage would have logged the file.
+        assert!(
+            !err.contains("reading"),
+            "{cmd} read its input first: {err}"
+        );
+        assert!(!out.exists());
+    }
+}
