@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::geometry::Csr;
-use crate::lines::Segmentation;
+use crate::lines::ClusterLabels;
 
 /// The neighbours of point `i` (none when the adjacency has no row for it).
 fn row_of(adjacency: &Csr, i: usize) -> &[u32] {
@@ -87,7 +87,7 @@ pub fn label_high(high: &[bool], adjacency: &Csr) -> Vec<Label> {
 }
 
 /// Region growing on `labels` (see the module documentation).
-pub fn grow(labels: &[Label], adjacency: &Csr) -> Segmentation {
+pub fn grow(labels: &[Label], adjacency: &Csr) -> ClusterLabels {
     let n = labels.len();
     let mut out = vec![u32::MAX; n];
     let mut sizes: Vec<u32> = Vec::new();
@@ -129,7 +129,7 @@ pub fn grow(labels: &[Label], adjacency: &Csr) -> Segmentation {
             }
         }
     }
-    Segmentation { labels: out, sizes }
+    ClusterLabels { labels: out, sizes }
 }
 
 /// The largest connected set of points whose value lies in the band `(a, b]` together with

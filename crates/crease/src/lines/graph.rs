@@ -13,14 +13,14 @@ use crate::spatial::KdIndex;
 
 /// An undirected graph over cluster vertices with sorted adjacency rows.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct Graph {
+pub struct ClusterGraph {
     adj: Vec<Vec<u32>>,
 }
 
-impl Graph {
+impl ClusterGraph {
     /// A graph of `n` vertices and no edges.
     pub fn new(n: usize) -> Self {
-        Graph {
+        ClusterGraph {
             adj: vec![Vec::new(); n],
         }
     }
@@ -167,7 +167,7 @@ pub fn build_all(
     labels: &[u32],
     sizes: &[u32],
     adjacency: &Csr,
-) -> (Clusters, Graph) {
+) -> (Clusters, ClusterGraph) {
     let m = sizes.len();
     let mut sums = vec![[0.0f64; 3]; m];
     for (p, &l) in points.iter().zip(labels) {
@@ -194,7 +194,7 @@ pub fn build_all(
     }
     pairs.sort_unstable();
     pairs.dedup();
-    let mut g = Graph::new(m);
+    let mut g = ClusterGraph::new(m);
     for [a, b] in pairs {
         g.add_edge(a, b);
     }
@@ -211,7 +211,7 @@ pub fn build_all(
 /// Step 3: G_extended. Adds an edge between two small clusters that share two large
 /// neighbouring clusters, when their representatives are closer than the largest distance
 /// between two adjacent small clusters of G_all (section 2.4). Returns the number added.
-pub fn extend(clusters: &Clusters, g: &mut Graph) -> usize {
+pub fn extend(clusters: &Clusters, g: &mut ClusterGraph) -> usize {
     let m = clusters.sizes.len();
     let dist =
         |a: u32, b: u32| vec3::dist(clusters.centers[a as usize], clusters.centers[b as usize]);
@@ -281,7 +281,7 @@ pub fn extend(clusters: &Clusters, g: &mut Graph) -> usize {
 /// representatives, edges involving a large cluster weighted above every small–small edge
 /// (Kruskal; ties by vertex ids), then without the edges involving a large cluster:
 /// G_pruned_mst (section 2.5).
-pub fn pruned_mst(clusters: &Clusters, g: &Graph) -> Graph {
+pub fn pruned_mst(clusters: &Clusters, g: &ClusterGraph) -> ClusterGraph {
     let m = g.num_vertices();
     let mut edges: Vec<(bool, f64, [u32; 2])> = g
         .edges()
@@ -297,7 +297,7 @@ pub fn pruned_mst(clusters: &Clusters, g: &Graph) -> Graph {
         .collect();
     edges.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)));
     let mut sets = UnionFind::new(m);
-    let mut out = Graph::new(m);
+    let mut out = ClusterGraph::new(m);
     for (large, _, [a, b]) in edges {
         if sets.union(a, b) && !large {
             out.add_edge(a, b);
@@ -308,7 +308,7 @@ pub fn pruned_mst(clusters: &Clusters, g: &Graph) -> Graph {
 
 /// Depth of the branch that starts at `p` through its neighbour `q` (longest path from p into
 /// that side, in edges), capped at `cap`. The graph must be a forest.
-fn branch_depth(g: &Graph, p: u32, q: u32, cap: usize) -> usize {
+fn branch_depth(g: &ClusterGraph, p: u32, q: u32, cap: usize) -> usize {
     // Iterative DFS with (vertex, parent, depth).
     let mut best = 1;
     let mut stack = vec![(q, p, 1usize)];
@@ -327,7 +327,7 @@ fn branch_depth(g: &Graph, p: u32, q: u32, cap: usize) -> usize {
 }
 
 /// Removes the branch from `p` through `q` (every vertex on q's side). Forest only.
-fn remove_branch(g: &mut Graph, p: u32, q: u32) {
+fn remove_branch(g: &mut ClusterGraph, p: u32, q: u32) {
     let mut stack = vec![(q, p)];
     let mut cut = Vec::new();
     while let Some((v, parent)) = stack.pop() {
@@ -345,7 +345,7 @@ fn remove_branch(g: &mut Graph, p: u32, q: u32) {
 
 /// Step 5: Algorithm 2 with maximum branch length `d_max` (section 2.6), repeated until
 /// nothing changes. Returns the number of branches removed.
-pub fn prune_branches(g: &mut Graph, d_max: usize) -> usize {
+pub fn prune_branches(g: &mut ClusterGraph, d_max: usize) -> usize {
     let mut removed = 0;
     loop {
         let mut changed = false;
@@ -418,7 +418,7 @@ const DIRECTION_MIN_STEPS: usize = 3;
 /// hooks (a branch whose last clusters turn back along itself). `None` for a branch shorter
 /// than [`DIRECTION_MIN_STEPS`] edges: a fragment of a line, whose two or three clusters may
 /// sit side by side across it.
-fn end_direction(clusters: &Clusters, g: &Graph, p: u32) -> Option<Point3> {
+fn end_direction(clusters: &Clusters, g: &ClusterGraph, p: u32) -> Option<Point3> {
     let (mut prev, mut v) = (p, *g.neighbors(p).first()?);
     let mut sum = clusters.centers[v as usize];
     let mut steps = 1;
@@ -447,7 +447,7 @@ const ALONG_COS: f64 = 0.87;
 /// direction of that line is the principal axis of the vertices within 3 edges of `q`. A
 /// branch that ends beside a line and parallel to it is a spur grown along the feature, not a
 /// line meeting it; a correct case-2 link (a T-junction, a corner) meets the line at an angle.
-fn along_line(clusters: &Clusters, g: &Graph, p: u32, q: u32) -> bool {
+fn along_line(clusters: &Clusters, g: &ClusterGraph, p: u32, q: u32) -> bool {
     let mut ring = vec![q];
     let mut frontier = vec![q];
     for _ in 0..3 {
@@ -502,7 +502,7 @@ fn along_line(clusters: &Clusters, g: &Graph, p: u32, q: u32) -> bool {
 /// (cube: 12 polylines and 8 junctions; two cylinders: 6 closed loops; box with hole and the
 /// fillet-chamfer-cone part: 14 polylines, 2 loops, 8 junctions), where the literal reading
 /// gave 9 to 20 polylines.
-pub fn close(clusters: &Clusters, g: &mut Graph, n: usize, d: usize) -> CloseReport {
+pub fn close(clusters: &Clusters, g: &mut ClusterGraph, n: usize, d: usize) -> CloseReport {
     let mut report = CloseReport::default();
     let active: Vec<u32> = (0..g.num_vertices() as u32)
         .filter(|&v| g.degree(v) > 0)
@@ -535,7 +535,7 @@ pub fn close(clusters: &Clusters, g: &mut Graph, n: usize, d: usize) -> CloseRep
         .map(|v| g.degree(v) > 1)
         .collect();
     // N of an endpoint: up to n vertices ahead of its branch within reach, nearest first.
-    let candidates = |g: &Graph, p: u32| -> Vec<(f64, u32)> {
+    let candidates = |g: &ClusterGraph, p: u32| -> Vec<(f64, u32)> {
         let mut near = Vec::with_capacity(n);
         let dir = end_direction(clusters, g, p);
         let cp = clusters.centers[p as usize];
@@ -647,7 +647,7 @@ pub fn boundary_graph(
     boundary: &[bool],
     adjacency: &Csr,
     d_max: usize,
-) -> (Vec<u32>, Graph) {
+) -> (Vec<u32>, ClusterGraph) {
     let ids: Vec<u32> = (0..points.len() as u32)
         .filter(|&i| boundary[i as usize])
         .collect();
@@ -672,7 +672,7 @@ pub fn boundary_graph(
     }
     links.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let mut sets = UnionFind::new(ids.len());
-    let mut g = Graph::new(ids.len());
+    let mut g = ClusterGraph::new(ids.len());
     for (_, [a, b]) in links {
         if sets.union(a, b) {
             g.add_edge(a, b);
@@ -682,9 +682,9 @@ pub fn boundary_graph(
     (ids, g)
 }
 
-impl Graph {
+impl ClusterGraph {
     /// Appends the vertices and edges of `other`, its vertex i becoming `self.num_vertices() + i`.
-    pub fn append(&mut self, other: &Graph) {
+    pub fn append(&mut self, other: &ClusterGraph) {
         let base = self.adj.len() as u32;
         self.adj.extend(
             other
@@ -703,7 +703,7 @@ impl Graph {
 /// cluster is sprinkled with islands of small clusters (section 3: "small clusters are created
 /// at the noisy parts"); such islands see only their own face's large cluster, and the spanning
 /// tree would otherwise wire them into spurious lines across the face.
-pub fn between_patches(clusters: &Clusters, g: &Graph, hops: usize) -> Vec<bool> {
+pub fn between_patches(clusters: &Clusters, g: &ClusterGraph, hops: usize) -> Vec<bool> {
     let m = g.num_vertices();
     let mut out = vec![false; m];
     let mut seen: Vec<u32> = Vec::new();

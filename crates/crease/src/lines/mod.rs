@@ -46,8 +46,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-pub use graph::{CloseReport, Graph};
-pub use segment::{region_grow, Segmentation};
+pub use graph::{CloseReport, ClusterGraph};
+pub use segment::{region_grow, ClusterLabels};
 
 use crate::analysis::CloudAnalysis;
 use crate::estimate::ring_normals;
@@ -122,7 +122,7 @@ pub struct LineNetwork {
     /// vertex at the end.
     pub polylines: Vec<Vec<u32>>,
     /// The first-order segmentation (per-point cluster labels).
-    pub segmentation: Segmentation,
+    pub segmentation: ClusterLabels,
     /// Small / large split of the clusters.
     pub small_clusters: usize,
     /// Per-stage counts and times.
@@ -184,7 +184,7 @@ pub struct FirstOrder {
     /// Least-squares plane normals of the 1-rings.
     pub normals: Vec<Point3>,
     /// Region growing with α_max on the normals.
-    pub segmentation: Segmentation,
+    pub segmentation: ClusterLabels,
     /// Seconds spent.
     pub seconds: f64,
 }
@@ -346,7 +346,7 @@ fn lines_of(points: &[Point3], first: &FirstOrder, params: &LinesParams) -> Resu
 /// Errors: invalid parameters.
 pub fn network(
     points: &[Point3],
-    seg: Segmentation,
+    seg: ClusterLabels,
     adjacency: &Csr,
     boundary: Option<&[bool]>,
     params: &LinesParams,
@@ -363,7 +363,7 @@ pub fn network(
         edges: g.num_edges(),
         seconds: seg_seconds + t.elapsed().as_secs_f64(),
     });
-    let mut timed = |name: &'static str, g: &Graph, t: Instant| {
+    let mut timed = |name: &'static str, g: &ClusterGraph, t: Instant| {
         stages.push(Stage {
             name,
             vertices: g.num_active_vertices(),

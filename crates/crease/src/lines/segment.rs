@@ -19,14 +19,14 @@ use crate::geometry::{vec3, Csr, Point3};
 
 /// Per-point cluster labels (0..num_clusters, numbered by their lowest point) and sizes.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Segmentation {
+pub struct ClusterLabels {
     /// Cluster of every point.
     pub labels: Vec<u32>,
     /// Number of points of every cluster.
     pub sizes: Vec<u32>,
 }
 
-impl Segmentation {
+impl ClusterLabels {
     /// Number of clusters.
     pub fn num_clusters(&self) -> usize {
         self.sizes.len()
@@ -35,7 +35,7 @@ impl Segmentation {
 
 /// Region growing over `adjacency` (symmetric CSR) with unoriented `normals`: adjacent points
 /// join the same cluster when their normals differ by at most `alpha_max` radians.
-pub fn region_grow(normals: &[Point3], adjacency: &Csr, alpha_max: f64) -> Segmentation {
+pub fn region_grow(normals: &[Point3], adjacency: &Csr, alpha_max: f64) -> ClusterLabels {
     let n = normals.len();
     let cos_max = alpha_max.cos();
     let mut labels = vec![u32::MAX; n];
@@ -70,7 +70,7 @@ pub fn region_grow(normals: &[Point3], adjacency: &Csr, alpha_max: f64) -> Segme
         }
         sizes.push(size);
     }
-    Segmentation { labels, sizes }
+    ClusterLabels { labels, sizes }
 }
 
 /// Median angle (radians) between the normals of adjacent points: the normal noise of a
