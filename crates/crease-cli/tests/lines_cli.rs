@@ -103,12 +103,19 @@ fn usage_errors() {
         err.contains("tiny.ply") && err.contains("15 points"),
         "{err}"
     );
+    // Plain option names, and the paper's symbols as aliases.
     for bad in [
         vec!["--alpha-max", "0"],
-        vec!["--alpha-max", "95"],
+        vec!["--region-angle", "95"],
         vec!["-k", "2"],
+        vec!["--neighbours", "2"],
+        vec!["--spur-length", "0"],
+        vec!["--close-candidates", "0"],
+        vec!["--n", "0"],
     ] {
-        run("lines", &input, &out, &bad).failure().code(2);
+        let a = run("lines", &input, &out, &bad).failure().code(2);
+        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+        assert!(err.contains("invalid argument"), "{bad:?}: {err}");
     }
     run("lines", &input, &input, &[]).failure().code(2);
 }

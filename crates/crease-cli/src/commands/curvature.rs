@@ -30,7 +30,7 @@ pub struct CurvatureArgs {
     #[arg(long, value_enum, default_value_t = Method::Quadric)]
     pub method: Method,
     /// Number of nearest neighbours of the quadric fit (at least 5).
-    #[arg(short, default_value_t = 20)]
+    #[arg(short = 'k', long = "neighbours", alias = "k", default_value_t = 20)]
     pub k: usize,
     /// Orient the quadric's normals with the normals stored in the input file (signed
     /// curvatures); without it each point is oriented so that its mean curvature is >= 0.

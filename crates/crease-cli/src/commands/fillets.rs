@@ -31,14 +31,25 @@ pub struct FilletsArgs {
     #[arg(long)]
     pub labels: Option<PathBuf>,
     /// Nearest neighbours triangulated for the Delaunay 1-rings.
-    #[arg(short, default_value_t = 20)]
+    #[arg(short = 'k', long = "neighbours", alias = "k", default_value_t = 20)]
     pub k: usize,
     /// Region-growing angle threshold between adjacent normals, degrees (the sharp edges that
     /// bound the smooth regions).
-    #[arg(long, default_value_t = 8.0)]
+    /// (α_max of demarsin2007 section 2.2.)
+    #[arg(
+        long = "region-angle",
+        alias = "alpha-max",
+        value_name = "DEGREES",
+        default_value_t = 8.0
+    )]
     pub alpha_max: f64,
-    /// Maximum length of the branches pruned by Algorithm 2.
-    #[arg(long, default_value_t = 5)]
+    /// Spurs of at most this many edges are pruned from the lines (d_max of Algorithm 2).
+    #[arg(
+        long = "spur-length",
+        alias = "d-max",
+        value_name = "EDGES",
+        default_value_t = 5
+    )]
     pub d_max: usize,
     /// Neighbours of the quadric fit of the mean curvature.
     #[arg(long, default_value_t = 20)]

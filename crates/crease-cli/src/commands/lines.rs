@@ -26,22 +26,35 @@ pub struct LinesArgs {
     #[arg(long)]
     pub segmentation: Option<PathBuf>,
     /// Nearest neighbours triangulated for the Delaunay 1-rings.
-    #[arg(short, default_value_t = 20)]
+    #[arg(short = 'k', long = "neighbours", alias = "k", default_value_t = 20)]
     pub k: usize,
     /// Region-growing angle threshold between adjacent normals, degrees.
-    #[arg(long, default_value_t = 8.0)]
+    /// (α_max of demarsin2007 section 2.2.)
+    #[arg(
+        long = "region-angle",
+        alias = "alpha-max",
+        value_name = "DEGREES",
+        default_value_t = 8.0
+    )]
     pub alpha_max: f64,
-    /// Maximum length of the branches pruned by Algorithm 2.
-    #[arg(long, default_value_t = 5)]
+    /// Spurs of at most this many edges are pruned from the lines (d_max of Algorithm 2).
+    #[arg(
+        long = "spur-length",
+        alias = "d-max",
+        value_name = "EDGES",
+        default_value_t = 5
+    )]
     pub d_max: usize,
     /// Do not smooth noisy 1-ring normals before the region growing (the paper as written).
     #[arg(long)]
     pub no_denoise: bool,
-    /// Candidates of the connect algorithm (default: 2 d_max, within a reach from the data).
-    #[arg(long)]
+    /// Closing the network: how many nearest line vertices an open end may link to (the
+    /// paper's n; default: 2 × --spur-length, within a reach from the data).
+    #[arg(long = "close-candidates", alias = "n", value_name = "N")]
     pub n: Option<usize>,
-    /// Shortest path allowed between two linked vertices (default: 2 d_max).
-    #[arg(long)]
+    /// Closing the network: two vertices already joined by a path of at most this many edges
+    /// are not linked (the paper's d; default: 2 × --spur-length).
+    #[arg(long = "close-path", alias = "d", value_name = "D")]
     pub d: Option<usize>,
     /// Leave the cloud's boundary out of the network.
     #[arg(long)]

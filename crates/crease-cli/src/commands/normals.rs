@@ -28,7 +28,7 @@ pub struct NormalsArgs {
     #[arg(long, value_enum, default_value_t = Method::Pca)]
     pub method: Method,
     /// Number of nearest neighbours (PCA, ring, and the --orient graph).
-    #[arg(short, long, default_value_t = 20)]
+    #[arg(short = 'k', long = "neighbours", alias = "k", default_value_t = 20)]
     pub k: usize,
     /// Make the signs consistent (Hoppe 1992: minimum spanning tree over the kNN graph, seeded
     /// at the highest point of each connected part, pointing +z there). Without it PCA and ring

@@ -36,14 +36,25 @@ pub struct SegmentArgs {
     /// Also draw the mesh coloured by surface type into this PNG.
     #[arg(long, value_name = "PNG")]
     pub render: Option<PathBuf>,
-    /// th_pos of equation 4, in mean edge lengths.
-    #[arg(long, default_value_t = 0.5)]
+    /// How far a point may lie from its surface, in mean edge lengths (th_pos of equation 4;
+    /// widened to the measured noise on noisy clouds).
+    #[arg(
+        long = "distance-tolerance",
+        alias = "th-pos",
+        value_name = "EDGES",
+        default_value_t = 0.5
+    )]
     pub th_pos: f64,
-    /// th_norm of equation 5, degrees.
-    #[arg(long, default_value_t = 8.0)]
+    /// How far a point's normal may turn from its surface's, degrees (th_norm of equation 5).
+    #[arg(
+        long = "angle-tolerance",
+        alias = "th-norm",
+        value_name = "DEGREES",
+        default_value_t = 8.0
+    )]
     pub th_norm: f64,
     /// Clouds: neighbours of the k-nearest-neighbour graph.
-    #[arg(long, default_value_t = 8)]
+    #[arg(short = 'k', long = "neighbours", alias = "k", default_value_t = 8)]
     pub k: usize,
     /// Clouds: estimate normals (PCA + orientation) even when the file has some.
     #[arg(long)]
