@@ -265,7 +265,7 @@ pub fn surface_normal(s: &SurfaceParams, p: Point3) -> Point3 {
 
 /// A surface with its per-surface constants computed once (the cone's sine and cosine of its
 /// half angle), for loops over many points: [`Prepared::signed_distance`] equals
-/// [`signed_distance`] bit for bit. Measured on a 9.7k-point scan (`scans/curvsurf`), the
+/// [`signed_distance`] and [`Prepared::normal`] [`surface_normal`] bit for bit. Measured on a 9.7k-point scan (`scans/curvsurf`), the
 /// per-point `sin_cos` of the cone's distance was half the segmentation's time, in the
 /// Levenberg–Marquardt refinements that evaluate every residual 2N + 1 times an iteration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -303,6 +303,26 @@ impl Prepared {
                 rho * self.cos - h * self.sin
             }
             ref s => signed_distance(s, p),
+        }
+    }
+
+    /// [`surface_normal`] at the point nearest to `p`.
+    #[inline]
+    pub fn normal(&self, p: Point3) -> Point3 {
+        match self.surface {
+            SurfaceParams::Cone { apex, axis_dir, .. } => {
+                let v = sub(p, apex);
+                let h = dot(v, axis_dir);
+                let r = sub(v, scale(axis_dir, h));
+                let rho = norm(r);
+                let u = if rho > 0.0 {
+                    scale(r, 1.0 / rho)
+                } else {
+                    [0.0; 3]
+                };
+                sub(scale(u, self.cos), scale(axis_dir, self.sin))
+            }
+            ref s => surface_normal(s, p),
         }
     }
 }

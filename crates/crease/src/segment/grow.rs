@@ -43,7 +43,7 @@ use crate::geometry::{SurfaceParams, SurfaceType};
 use crate::spatial::Adjacency;
 
 use super::fit::{fit, Fit};
-use crate::geometry::surface::{signed_distance, surface_normal};
+use crate::geometry::surface::{signed_distance, surface_normal, Prepared};
 
 /// Tolerances of the compatibility tests.
 #[derive(Debug, Clone, Copy)]
@@ -57,8 +57,8 @@ pub(crate) struct Tol {
 impl Tol {
     /// Equations 4 and 5.
     #[inline]
-    pub fn ok(&self, s: &SurfaceParams, p: Point3, n: Point3) -> bool {
-        signed_distance(s, p).abs() < self.pos && dot(surface_normal(s, p), n).abs() > self.cos_norm
+    pub fn ok(&self, s: &Prepared, p: Point3, n: Point3) -> bool {
+        s.signed_distance(p).abs() < self.pos && dot(s.normal(p), n).abs() > self.cos_norm
     }
 }
 
@@ -85,7 +85,7 @@ impl<G: Adjacency> Ctx<'_, G> {
     }
 
     /// Equations 4 and 5 for vertex `v`.
-    pub fn ok(&self, s: &SurfaceParams, v: u32) -> bool {
+    pub fn ok(&self, s: &Prepared, v: u32) -> bool {
         self.tol
             .ok(s, self.pos[v as usize], self.vnormal[v as usize])
     }
@@ -108,6 +108,7 @@ fn grow_bfs<G: Adjacency>(
     region: &mut Vec<u32>,
     owner: &mut [i32],
 ) {
+    let s = &Prepared::new(s);
     let mut head = 0;
     while head < region.len() {
         let u = region[head] as usize;
@@ -147,10 +148,11 @@ pub(crate) fn grow_seed<G: Adjacency>(
         Some(f) => f,
         None => ctx.fit(kind, &free)?,
     };
+    let prepared = Prepared::new(&f.params);
     let core: Vec<u32> = free
         .iter()
         .copied()
-        .filter(|&v| ctx.ok(&f.params, v))
+        .filter(|&v| ctx.ok(&prepared, v))
         .collect();
     if core.len() < min_seed.max(1) || (core.len() as f64) < min_core_fraction * free.len() as f64 {
         return None;
@@ -205,6 +207,10 @@ pub(crate) fn refine_borders<G: Adjacency>(
 ) {
     use rayon::prelude::*;
     for _ in 0..passes {
+        let prepared: Vec<Prepared> = regions
+            .iter()
+            .map(|r| Prepared::new(&r.fit.params))
+            .collect();
         let next: Vec<i32> = (0..owner.len())
             .into_par_iter()
             .map(|v| {
@@ -213,7 +219,7 @@ pub(crate) fn refine_borders<G: Adjacency>(
                     return o;
                 }
                 let p = ctx.pos[v];
-                let mut best = (signed_distance(&regions[o as usize].fit.params, p).abs(), o);
+                let mut best = (prepared[o as usize].signed_distance(p).abs(), o);
                 let mut seen = [o; 8];
                 let mut nseen = 1;
                 ctx.topo.for_each_neighbor(v, |w| {
@@ -225,8 +231,8 @@ pub(crate) fn refine_borders<G: Adjacency>(
                         seen[nseen] = c;
                         nseen += 1;
                     }
-                    let s = &regions[c as usize].fit.params;
-                    let d = signed_distance(s, p).abs();
+                    let s = &prepared[c as usize];
+                    let d = s.signed_distance(p).abs();
                     if d < best.0 && ctx.ok(s, v as u32) {
                         best = (d, c);
                     }

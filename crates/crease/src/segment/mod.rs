@@ -77,6 +77,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::estimate::bezier::{bezier_curvature_with_sharp, BezierCurvature, BezierParams};
+use crate::geometry::surface::Prepared;
 use crate::geometry::{face_areas, Aabb, MeshTopology, Point3, TriMesh};
 use crate::geometry::{SurfaceParams, SurfaceType};
 use crate::spatial::Adjacency;
@@ -403,10 +404,11 @@ fn trimmed_fit<G: Adjacency>(
     let mut f = ctx.fit(k, vs)?;
     let mut current: Vec<u32> = vs.to_vec();
     for _ in 0..3 {
+        let prepared = Prepared::new(&f.params);
         let inl: Vec<u32> = vs
             .iter()
             .copied()
-            .filter(|&v| ctx.ok(&f.params, v))
+            .filter(|&v| ctx.ok(&prepared, v))
             .collect();
         if inl.len() < min_points(k).max(vs.len() / 4) {
             break;
@@ -420,7 +422,8 @@ fn trimmed_fit<G: Adjacency>(
         }
         current = inl;
     }
-    let inl = vs.iter().filter(|&&v| ctx.ok(&f.params, v)).count();
+    let prepared = Prepared::new(&f.params);
+    let inl = vs.iter().filter(|&&v| ctx.ok(&prepared, v)).count();
     Some((f, inl))
 }
 
@@ -453,10 +456,11 @@ fn reselect<G: Adjacency>(
     };
     let (it, sampled) = fit_sample(&r.vertices);
     let sample: Vec<u32> = it.collect();
+    let prepared = Prepared::new(&r.fit.params);
     let inl: Vec<u32> = sample
         .iter()
         .copied()
-        .filter(|&v| ctx.ok(&r.fit.params, v))
+        .filter(|&v| ctx.ok(&prepared, v))
         .collect();
     if inl.is_empty() {
         return false;
@@ -876,7 +880,7 @@ fn hand_over<G: Adjacency>(
     regions: &mut [grow::Region],
 ) {
     for (&v, &s) in r.vertices.iter().zip(best) {
-        if s >= 0 && ctx.ok(&regions[s as usize].fit.params, v) {
+        if s >= 0 && ctx.ok(&Prepared::new(&regions[s as usize].fit.params), v) {
             owner[v as usize] = s;
             regions[s as usize].vertices.push(v);
         } else {
