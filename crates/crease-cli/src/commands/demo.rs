@@ -291,7 +291,22 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
 
     // 6. Pictures.
     let s = Stage::start("rendering", g.quiet);
-    let lines = super::render::polylines_of(&curves, 0);
+    // The exact curves, drawn apart from anything detected: dark grey for sharp curves, green
+    // for fillet borders, each with its own legend entry (detected points and lines are red and
+    // blue).
+    let lines: Vec<crease::render::Polyline> = super::render::polylines_of(&curves, 0)
+        .into_iter()
+        .map(|mut l| {
+            let (color, label) = match l.label.as_deref() {
+                Some("smooth") => ([40, 160, 60], "true fillet curve"),
+                Some("boundary") => ([110, 110, 110], "true boundary"),
+                _ => ([40, 40, 40], "true sharp curve"),
+            };
+            l.color = color;
+            l.label = Some(label.to_string());
+            l
+        })
+        .collect();
     let pictures = [
         (
             "part-sharp.png",
@@ -397,7 +412,8 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
         polylines: Vec::new(),
     };
     let params = RenderParams {
-        color_by: ColorBy::Attribute("surface_type".into()),
+        // By surface id: each surface its own colour (by type, the 8 planes would look alike).
+        color_by: ColorBy::Attribute("surface".into()),
         title: Some(format!(
             "{SHAPE}, mesh segmented into {} analytic surfaces (Mizoguchi)",
             seg.surfaces.len()
