@@ -598,3 +598,72 @@ fn a_missing_output_folder_is_reported_before_any_work() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn a_face_repeating_a_vertex_is_no_panic() {
+    // Seen by a mutation fuzzer: `f 1 1 2` made `crease edges` and `crease segment` index an
+    // edge that a degenerate face side does not have.
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("r.obj");
+    std::fs::write(
+        &input,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 1 2\nf 2 4 3\n",
+    )
+    .unwrap();
+    for (cmd, out) in [("edges", "e.ply"), ("segment", "s.ply")] {
+        let o = crease()
+            .arg(cmd)
+            .arg(&input)
+            .arg("-o")
+            .arg(dir.path().join(out))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{cmd}: {err}");
+        assert!(!err.contains("panicked"), "{cmd}: {err}");
+    }
+    // The real face's three edges and the degenerate face's one real side (vertices 1-2).
+    let (g, _) = crease::io::read(dir.path().join("e.ply"), &Default::default()).unwrap();
+    assert_eq!(g.edges.len(), 4);
+}
+
+#[test]
+fn a_closed_output_pipe_ends_quietly() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = common::synth(dir.path(), &["synth", "cube", "-n", "2000"], "cube.ply");
+    for args in [vec!["info"], vec!["info", "--json"]] {
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("crease"))
+            .args(&args)
+            .arg(&input)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The reader goes away before crease writes: every write fails with a broken pipe.
+        drop(child.stdout.take());
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{args:?}: {err}");
+        assert!(err.is_empty(), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn error_messages_quote_short_excerpts() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("long.ply");
+    let keyword = "x".repeat(1_000_000);
+    std::fs::write(
+        &input,
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n{keyword}\nend_header\n0\n"
+        ),
+    )
+    .unwrap();
+    let o = crease().arg("info").arg(&input).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("header line 5: unknown keyword"), "{err}");
+    assert!(err.contains("1000000 bytes"), "{err}");
+    assert!(err.len() < 400, "{} bytes of error", err.len());
+}

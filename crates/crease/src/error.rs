@@ -71,5 +71,15 @@ impl Error {
     }
 }
 
+/// A piece of input quoted in an error message, at most 40 characters (with the total length
+/// when cut): a corrupt file must not turn into an error message megabytes long.
+pub(crate) fn excerpt(text: &str) -> String {
+    const MAX: usize = 40;
+    match text.char_indices().nth(MAX) {
+        None => format!("{text:?}"),
+        Some((cut, _)) => format!("{:?}… ({} bytes)", &text[..cut], text.len()),
+    }
+}
+
 /// The library's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -504,13 +504,13 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
     if g.json {
         crate::ui::print_json(&result)?;
     } else if !g.quiet {
-        println!(
+        crate::ui::outln(format_args!(
             "crease demo: {SHAPE} sampled with {} points (spacing {:.5}), {} of them within one spacing of a sharp edge;",
             part.cloud.len(),
             summary.spacing.unwrap_or(0.0),
             sharp
-        );
-        println!(
+        ))?;
+        crate::ui::outln(format_args!(
             "{} analytic surfaces, {} feature curves; mesh of {} vertices / {} triangles ({}).",
             part.surfaces.len(),
             part.curves.len(),
@@ -521,42 +521,42 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
             } else {
                 "open"
             }
-        );
-        println!(
+        ))?;
+        crate::ui::outln(format_args!(
             "estimated normals (PCA, k = 20, oriented): median error {:.2} deg, 95th percentile {:.2} deg against the exact normals.",
             pct(0.5).unwrap_or(f64::NAN),
             pct(0.95).unwrap_or(f64::NAN)
-        );
-        println!(
+        ))?;
+        crate::ui::outln(format_args!(
             "sharp points (projected distance, 8 scales): {} detected, F1 {:.3} exact / {:.3} within two spacings; mesh vertices F1 {:.3}.",
             detected.num_sharp(),
             confusion.f1(),
             tolerant.map_or(f64::NAN, |t| t.f1),
             mesh_confusion.f1()
-        );
-        println!(
+        ))?;
+        crate::ui::outln(format_args!(
             "closed sharp lines (Demarsin 2007): {} polylines, {} closed loops, {} junctions, {} endpoints.",
             net.polylines.len(),
             net.closed_loops(),
             net.junctions(),
             net.endpoints()
-        );
-        println!(
+        ))?;
+        crate::ui::outln(format_args!(
             "curve network (Demarsin 2007 + 2008, noise 5 % of the spacing): {} sharp and {} fillet polylines, {} of {} fillet ends joined to sharp lines.",
             network.polylines.len() - smooth_lines,
             smooth_lines,
             network.joined_ends,
             network.joined_ends + network.open_ends
-        );
-        println!(
+        ))?;
+        crate::ui::outln(format_args!(
             "segmentation of the mesh (Mizoguchi): {} analytic surfaces {}, {} recognised groups.",
             seg.surfaces.len(),
             serde_json::Value::Object(surface_types.clone()),
             seg.groups.len()
-        );
+        ))?;
         let auc_of = |m: &str| result["mesh_feature_edges"]["methods"][m]["auc"].as_f64();
         let f1_of = |m: &str| result["mesh_feature_edges"]["methods"][m]["exact"]["f1"].as_f64();
-        println!(
+        crate::ui::outln(format_args!(
             "mesh feature edges (Vidal 2011, noisy mesh): fused AUC {:.3}, F1 {:.3}; filtered {:.3}, {:.3}; dihedral thresholding {:.3}, {:.3}.",
             auc_of("fused").unwrap_or(f64::NAN),
             f1_of("fused").unwrap_or(f64::NAN),
@@ -564,8 +564,12 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
             f1_of("filtered").unwrap_or(f64::NAN),
             auc_of("dihedral").unwrap_or(f64::NAN),
             f1_of("dihedral").unwrap_or(f64::NAN)
-        );
-        println!("results in {}/: {}", dir.display(), result["files"]);
+        ))?;
+        crate::ui::outln(format_args!(
+            "results in {}/: {}",
+            dir.display(),
+            result["files"]
+        ))?;
     }
     Ok(())
 }

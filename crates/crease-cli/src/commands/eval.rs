@@ -145,10 +145,13 @@ pub fn run(g: &Global, a: &EvalArgs) -> anyhow::Result<()> {
         v["roc_csv"] = serde_json::json!(a.roc);
         crate::ui::print_json(&v)?;
     } else {
-        print!(
-            "{}",
-            text_report(a, &truth.source, &a.label, score_name, &report)
-        );
+        crate::ui::out(&text_report(
+            a,
+            &truth.source,
+            &a.label,
+            score_name,
+            &report,
+        ))?;
     }
     Ok(())
 }
@@ -275,9 +278,11 @@ fn run_edges(g: &Global, a: &EvalArgs) -> anyhow::Result<()> {
         v["roc_csv"] = serde_json::json!(a.roc);
         crate::ui::print_json(&v)?;
     } else {
-        print!("{}", text_report(a, &source, &a.label, score_name, &report));
+        crate::ui::out(&text_report(a, &source, &a.label, score_name, &report))?;
         if missing > 0 {
-            println!("note: {missing} true edges are not edges of the prediction");
+            crate::ui::outln(format_args!(
+                "note: {missing} true edges are not edges of the prediction"
+            ))?;
         }
     }
     Ok(())

@@ -15,8 +15,8 @@ pub fn run(g: &Global, input: &Path) -> anyhow::Result<()> {
         v["file"] = serde_json::json!(input);
         crate::ui::print_json(&v)?;
     } else {
-        println!("file        {}", input.display());
-        print!("{summary}");
+        crate::ui::outln(format_args!("file        {}", input.display()))?;
+        crate::ui::out(&summary.to_string())?;
     }
     Ok(())
 }

@@ -14,7 +14,7 @@ use crate::ui::{usage, Stage};
 pub fn run(g: &Global, a: &SynthArgs) -> anyhow::Result<()> {
     if a.list {
         for name in Shape::names() {
-            println!("{name}");
+            crate::ui::outln(format_args!("{name}"))?;
         }
         return Ok(());
     }

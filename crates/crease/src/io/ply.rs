@@ -242,7 +242,8 @@ fn parse_type(path: &Path, line: usize, tok: Option<&str>) -> Result<ScalarKind>
         Error::format(
             path,
             format!(
-                "header line {line}: unknown property type {t:?}; expected one of {TYPE_NAMES}"
+                "header line {line}: unknown property type {}; expected one of {TYPE_NAMES}",
+                crate::error::excerpt(t)
             ),
         )
     })
@@ -300,7 +301,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
                 let enc = PlyEncoding::from_header_name(name).ok_or_else(|| {
                     Error::format(
                         path,
-                        format!("header line {line_no}: unknown format {name:?}; expected ascii, binary_little_endian or binary_big_endian"),
+                        format!("header line {line_no}: unknown format {}; expected ascii, binary_little_endian or binary_big_endian", crate::error::excerpt(name)),
                     )
                 })?;
                 let version = toks.next().unwrap_or("1.0").to_string();
@@ -320,7 +321,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
                     .ok_or_else(|| {
                         Error::format(
                             path,
-                            format!("header line {line_no}: element `{name}` has count {count:?}; expected a non-negative integer"),
+                            format!("header line {line_no}: element `{}` has count {}; expected a non-negative integer", crate::error::excerpt(name), crate::error::excerpt(count)),
                         )
                     })?;
                 elements.push(ElementDef {
@@ -375,7 +376,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
             Some(other) => {
                 return Err(Error::format(
                     path,
-                    format!("header line {line_no}: unknown keyword {other:?}; expected format, comment, obj_info, element, property or end_header"),
+                    format!("header line {line_no}: unknown keyword {}; expected format, comment, obj_info, element, property or end_header", crate::error::excerpt(other)),
                 ))
             }
         }

@@ -124,6 +124,10 @@ pub fn tv_normals(em: &EdgeMesh, init: &[Point3], params: &TvParams) -> Vec<Poin
         .into_par_iter()
         .map(|f| {
             face_edges[f].map(|e| {
+                if e == crate::geometry::topology::NO_EDGE {
+                    // A side whose two corners are one vertex (a degenerate face): no neighbour.
+                    return u32::MAX;
+                }
                 let fs = topo.edge_faces(e as usize);
                 match fs {
                     [a, b] if *a as usize == f => *b,

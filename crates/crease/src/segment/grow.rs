@@ -44,6 +44,7 @@ use crate::spatial::Adjacency;
 
 use super::fit::{fit, Fit};
 use crate::geometry::surface::{signed_distance, surface_normal, Prepared};
+use crate::geometry::topology::NO_EDGE;
 
 /// Tolerances of the compatibility tests.
 #[derive(Debug, Clone, Copy)]
@@ -348,7 +349,7 @@ pub(crate) fn assign_faces(
                     return face[f];
                 }
                 let mut c = Vec::new();
-                for &e in &fe[f] {
+                for &e in fe[f].iter().filter(|&&e| e != NO_EDGE) {
                     for &g in topo.edge_faces(e as usize) {
                         if g as usize != f {
                             c.push(face[g as usize]);
@@ -408,7 +409,7 @@ pub(crate) fn planar_face_patches(
         while head < comp.len() {
             let f = comp[head] as usize;
             head += 1;
-            for &e in &fe[f] {
+            for &e in fe[f].iter().filter(|&&e| e != NO_EDGE) {
                 if dihedral[e as usize] > crease {
                     continue;
                 }
