@@ -19,7 +19,14 @@ fn main() -> ExitCode {
         }
     };
     ui::init_logging(cli.global.verbose, cli.global.quiet);
-    if let Some(n) = cli.global.threads {
+    if let Some(mut n) = cli.global.threads {
+        // More threads than cores only costs memory and start-up time (10,000 threads did not
+        // start `crease info` within a minute).
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        if n > cores {
+            tracing::warn!("--threads {n}: this machine has {cores} cores; using {cores}");
+            n = cores;
+        }
         if let Err(e) = rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()

@@ -114,7 +114,7 @@ pub fn ensure_not_input(output: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
     }
     let out = canonical(output);
     for inp in inputs {
-        if canonical(inp) == out {
+        if canonical(inp) == out || same_file(inp, output) {
             return Err(usage(format!(
                 "{}: the output file is the input file; crease never overwrites its input, choose another output name",
                 output.display()
@@ -122,6 +122,22 @@ pub fn ensure_not_input(output: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// True when both paths exist and are the same file (device and inode): a hard link to the
+/// input is the input.
+#[cfg(unix)]
+fn same_file(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn same_file(_: &Path, _: &Path) -> bool {
+    false
 }
 
 /// The canonical form of a path that may not exist yet (its parent canonicalised).
@@ -137,6 +153,14 @@ fn canonical(p: &Path) -> std::path::PathBuf {
         (Ok(dir), Some(name)) => dir.join(name),
         _ => p.to_path_buf(),
     }
+}
+
+/// Writes `text` to `path`, replacing it atomically (`crease::io::atomic`).
+pub fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
+    crease::io::atomic::replace(path, |tmp| {
+        std::fs::write(tmp, text).map_err(|e| crease::Error::io(tmp, e))
+    })?;
+    Ok(())
 }
 
 /// Writes one line to stdout. A closed pipe (`crease info scan.ply | head -1`) is an error

@@ -667,3 +667,87 @@ fn error_messages_quote_short_excerpts() {
     assert!(err.contains("1000000 bytes"), "{err}");
     assert!(err.len() < 400, "{} bytes of error", err.len());
 }
+
+#[test]
+fn a_killed_convert_never_leaves_a_truncated_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = common::synth(dir.path(), &["synth", "cube", "-n", "300000"], "cube.ply");
+    let (src, _) = crease::io::read(&input, &Default::default()).unwrap();
+    let out = dir.path().join("copy.xyz");
+    // A complete previous output.
+    crease()
+        .args(["convert", "-q"])
+        .arg(&input)
+        .arg(&out)
+        .assert()
+        .success();
+    let previous = std::fs::read(&out).unwrap();
+    for delay_ms in [5u64, 20, 60, 150, 400] {
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("crease"))
+            .args(["convert", "-q"])
+            .arg(&input)
+            .arg(&out)
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let _ = child.kill(); // SIGKILL
+        let _ = child.wait();
+        // Either the previous file or a complete new one (the same bytes): never a part.
+        let now = std::fs::read(&out).unwrap();
+        assert_eq!(now.len(), previous.len(), "killed after {delay_ms} ms");
+        assert!(now == previous, "killed after {delay_ms} ms");
+    }
+    let (copy, _) = crease::io::read(&out, &Default::default()).unwrap();
+    assert_eq!(copy.points.len(), src.points.len());
+}
+
+#[test]
+fn a_hard_link_to_the_input_is_refused_as_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = common::synth(dir.path(), &["synth", "cube", "-n", "2000"], "cube.ply");
+    let link = dir.path().join("cube-link.xyz");
+    std::fs::hard_link(&input, &link).unwrap();
+    let before = std::fs::read(&input).unwrap();
+    crease()
+        .arg("convert")
+        .arg(&input)
+        .arg(&link)
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("is the input file"));
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+}
+
+#[test]
+fn inputs_that_are_not_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("scan.ply");
+    std::fs::create_dir(&folder).unwrap();
+    for input in [folder.as_path(), Path::new("/dev/zero.ply")] {
+        if !input.exists() {
+            continue;
+        }
+        crease()
+            .arg("info")
+            .arg(input)
+            .timeout(std::time::Duration::from_secs(20))
+            .assert()
+            .code(1)
+            .stderr(predicates::str::contains("not a regular file"));
+    }
+    // A FIFO named like a point cloud: refused at once, not read forever.
+    let fifo = dir.path().join("pipe.xyz");
+    if std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        crease()
+            .arg("info")
+            .arg(&fifo)
+            .timeout(std::time::Duration::from_secs(20))
+            .assert()
+            .code(1)
+            .stderr(predicates::str::contains("not a regular file"));
+    }
+}

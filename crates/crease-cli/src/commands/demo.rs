@@ -47,9 +47,9 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
     super::save(g, &cloud_path, &cloud_geom, false, &[])?;
     let curves = part.curves_geometry();
     super::save(g, &curves_path, &curves, false, &[])?;
-    std::fs::write(
-        dir.join("part.truth.json"),
-        serde_json::to_string_pretty(&part.ground_truth_json())?,
+    crate::ui::write_text(
+        &dir.join("part.truth.json"),
+        &serde_json::to_string_pretty(&part.ground_truth_json())?,
     )?;
     time("write", s);
 
@@ -497,9 +497,9 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
                   "run/network.obj", "run/surfaces.json", "run/summary.json", "run/picture.png"],
         "seconds": timings,
     });
-    std::fs::write(
-        dir.join("summary.json"),
-        serde_json::to_string_pretty(&result)?,
+    crate::ui::write_text(
+        &dir.join("summary.json"),
+        &serde_json::to_string_pretty(&result)?,
     )?;
     if g.json {
         crate::ui::print_json(&result)?;

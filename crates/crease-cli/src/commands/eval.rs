@@ -4,7 +4,6 @@
 //! tolerance, and the ROC curve and AUC of a continuous score. The measures live in
 //! `crease::eval`.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
@@ -296,15 +295,11 @@ fn same_path(a: &Path, b: &Path) -> bool {
 }
 
 fn write_roc(path: &Path, roc: &crease::eval::Roc) -> anyhow::Result<()> {
-    let err = |e: std::io::Error| anyhow::anyhow!("{}: {e}", path.display());
-    let f = std::fs::File::create(path).map_err(err)?;
-    let mut w = std::io::BufWriter::new(f);
-    writeln!(w, "threshold,fpr,tpr").map_err(err)?;
+    let mut text = String::from("threshold,fpr,tpr\n");
     for p in &roc.points {
-        writeln!(w, "{},{},{}", p.threshold, p.fpr, p.tpr).map_err(err)?;
+        text += &format!("{},{},{}\n", p.threshold, p.fpr, p.tpr);
     }
-    w.flush().map_err(err)?;
-    Ok(())
+    crate::ui::write_text(path, &text)
 }
 
 /// The text report: the inputs, then an aligned table of the exact and tolerant scores.

@@ -280,12 +280,9 @@ fn write_surfaces(
     write_json(&dir.join("surfaces.json"), &doc)
 }
 
-/// Writes JSON to a temporary file beside `path`, then renames it into place.
+/// Writes pretty JSON to `path`, replaced atomically.
 fn write_json(path: &Path, value: &serde_json::Value) -> anyhow::Result<()> {
-    let tmp = path.with_extension("json.part");
-    std::fs::write(&tmp, serde_json::to_string_pretty(value)? + "\n")
-        .with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))
+    crate::ui::write_text(path, &(serde_json::to_string_pretty(value)? + "\n"))
 }
 
 fn picture_line(ids: &[u32], vertices: &[[f64; 3]], smooth: bool) -> Polyline {

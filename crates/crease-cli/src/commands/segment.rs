@@ -215,8 +215,7 @@ fn finish(
         "groups": s.groups,
     });
     if let Some(p) = &a.primitives {
-        std::fs::write(p, serde_json::to_string_pretty(&doc)? + "\n")
-            .with_context(|| format!("cannot write {}", p.display()))?;
+        crate::ui::write_text(p, &(serde_json::to_string_pretty(&doc)? + "\n"))?;
     }
     if let Some(png) = &a.render {
         let params = crease::render::RenderParams {

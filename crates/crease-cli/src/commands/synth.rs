@@ -5,7 +5,6 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use crease::synth::{self, MeshParams, Noise, NoiseScale, SampleParams, Shape};
 
 use crate::args::{Global, NoiseMode, NoiseScaleArg, SynthArgs};
@@ -87,8 +86,7 @@ pub fn run(g: &Global, a: &SynthArgs) -> anyhow::Result<()> {
     let truth_path = sibling(output, "truth.json");
     super::save(g, output, &geom, a.ascii, &[])?;
     super::save(g, &curves_path, &curves, a.ascii, &[])?;
-    std::fs::write(&truth_path, serde_json::to_string_pretty(&truth)?)
-        .with_context(|| format!("cannot write {}", truth_path.display()))?;
+    crate::ui::write_text(&truth_path, &serde_json::to_string_pretty(&truth)?)?;
     if g.json {
         crate::ui::print_json(&serde_json::json!({
             "shape": name, "output": output, "curves": curves_path, "truth": truth_path,

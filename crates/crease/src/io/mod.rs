@@ -11,6 +11,7 @@ use std::path::Path;
 use crate::geometry::{Attributes, PointCloud, TriMesh};
 use crate::{Error, Result};
 
+pub mod atomic;
 #[cfg(feature = "e57")]
 pub mod e57;
 #[cfg(feature = "las")]
@@ -240,6 +241,14 @@ pub struct ReadReport {
 pub fn read(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<(Geometry, ReadReport)> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
+    // A FIFO or a device would be read forever (`/dev/urandom`), a folder cannot be read.
+    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if !meta.is_file() {
+        return Err(Error::InvalidInput(format!(
+            "{}: not a regular file (a folder, a FIFO or a device); give a point cloud or mesh file",
+            path.display()
+        )));
+    }
     let (mut geom, mut report) = match format {
         Format::Ply => ply::read(path)?,
         Format::Obj => obj::read(path)?,
@@ -284,10 +293,18 @@ pub fn read_mesh(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<(TriMesh,
 /// Point formats (XYZ, PCD, LAS, E57) write the points of any geometry: a mesh's vertices,
 /// without its faces, which is what converting a mesh to a point format means. Per-point data a
 /// format has no room for (e.g. arbitrary attributes in XYZ) is left out; PLY keeps everything.
+///
+/// The file is replaced atomically ([`atomic`]): an interrupted run never leaves a truncated
+/// output.
 pub fn write(path: impl AsRef<Path>, geom: &Geometry, opts: &WriteOptions) -> Result<()> {
     let path = path.as_ref();
     geom.validate()?;
-    match Format::from_path(path)? {
+    let format = Format::from_path(path)?;
+    atomic::replace(path, |tmp| write_format(tmp, format, geom, opts))
+}
+
+fn write_format(path: &Path, format: Format, geom: &Geometry, opts: &WriteOptions) -> Result<()> {
+    match format {
         Format::Ply => ply::write(path, geom, opts),
         Format::Obj => obj::write(path, geom, opts),
         Format::Off => off::write(path, geom, opts),

@@ -228,7 +228,9 @@ impl SvmModel {
 
     /// Writes the model file.
     pub fn write(&self, path: &std::path::Path) -> Result<()> {
-        std::fs::write(path, self.to_json()).map_err(|e| Error::io(path, e))
+        crate::io::atomic::replace(path, |tmp| {
+            std::fs::write(tmp, self.to_json()).map_err(|e| Error::io(tmp, e))
+        })
     }
 
     /// The decision value d(e) of every edge (positive = feature edge), in parallel.

@@ -660,8 +660,10 @@ pub fn render_png(scene: &Scene, params: &RenderParams, path: &Path) -> Result<(
     let bytes = pixmap
         .encode_png()
         .map_err(|e| Error::format(path, format!("cannot encode PNG: {e}")))?;
-    let mut out = crate::io::create(path)?;
-    out.write_all(&bytes)
-        .and_then(|()| out.flush())
-        .map_err(|e| Error::io(path, e))
+    crate::io::atomic::replace(path, |tmp| {
+        let mut out = crate::io::create(tmp)?;
+        out.write_all(&bytes)
+            .and_then(|()| out.flush())
+            .map_err(|e| Error::io(tmp, e))
+    })
 }
