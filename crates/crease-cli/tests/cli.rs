@@ -751,3 +751,43 @@ fn inputs_that_are_not_files_are_refused() {
             .stderr(predicates::str::contains("not a regular file"));
     }
 }
+
+#[test]
+fn extreme_coordinates_give_answers_or_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = dir.path().join("grid.xyz");
+    let text: String = (0..25)
+        .map(|i| format!("{} {} 0\n", (i % 5) as f64 * 1e19, (i / 5) as f64 * 1e19))
+        .collect();
+    std::fs::write(&grid, text).unwrap();
+    for cmd in ["normals", "segment"] {
+        let o = crease()
+            .arg(cmd)
+            .arg(&grid)
+            .arg("-o")
+            .arg(dir.path().join(format!("{cmd}.ply")))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{cmd}: {err}");
+    }
+    // A flat grid spaced 1e19 is one plane.
+    let (seg, _) = crease::io::read(dir.path().join("segment.ply"), &Default::default()).unwrap();
+    let surface = &seg.points.attribute("surface").unwrap().values;
+    assert!(surface.iter().all(|&s| s == 0.0), "{surface:?}");
+
+    let far = dir.path().join("far.xyz");
+    let mut text: String = (0..400)
+        .map(|i| format!("{} {} {}\n", (i % 20) as f64, (i / 20) as f64, 0.0))
+        .collect();
+    text += "1e308 0 0\n";
+    std::fs::write(&far, text).unwrap();
+    crease()
+        .arg("segment")
+        .arg(&far)
+        .arg("-o")
+        .arg(dir.path().join("far.ply"))
+        .assert()
+        .code(1)
+        .stderr(predicates::str::contains("overflow"));
+}

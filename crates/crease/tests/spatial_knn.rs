@@ -450,3 +450,46 @@ fn cpu_seconds() -> f64 {
     let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
     (t(11) + t(12)) / 100.0
 }
+
+/// Clouds spaced far beyond or below the f32 range of the block search: exact answers, no
+/// panic (a 25-point grid spaced 1e19 indexed out of bounds).
+#[test]
+fn extreme_spacings_are_exact() {
+    for spacing in [1e19, 1e30, 1e-20, 1e-40] {
+        let p: Vec<Point3> = (0..25)
+            .map(|i| {
+                [
+                    (i % 5) as f64 * spacing,
+                    (i / 5) as f64 * spacing * 1.01,
+                    0.0,
+                ]
+            })
+            .collect();
+        for k in [4, 8] {
+            let nb = knn(&p, k).expect("knn");
+            for i in 0..p.len() {
+                assert_eq!(
+                    nb.of(i),
+                    brute_knn(&p, i, k).as_slice(),
+                    "spacing {spacing}"
+                );
+            }
+            let sets = knn_map_set(
+                &p,
+                k,
+                || (),
+                |_, q: &KnnQuery| {
+                    let mut ids = q.ids.to_vec();
+                    ids.sort_unstable();
+                    ids
+                },
+            )
+            .expect("knn_map_set");
+            for (i, ids) in sets.iter().enumerate() {
+                let mut want = brute_knn(&p, i, k);
+                want.sort_unstable();
+                assert_eq!(ids, &want, "spacing {spacing}");
+            }
+        }
+    }
+}

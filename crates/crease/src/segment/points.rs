@@ -356,7 +356,14 @@ pub(crate) fn segment_core(
         .iter()
         .fold((0.0, 0usize), |(s, c), &(a, b)| (s + a, c + b));
     let l = sum / cnt.max(1) as f64;
-    if !(l > 0.0 && l.is_finite()) {
+    if !l.is_finite() {
+        return Err(Error::InvalidInput(
+            "point segmentation: distances between neighbours overflow (coordinates near \
+             1e308); move or scale the cloud, or remove the far outliers"
+                .into(),
+        ));
+    }
+    if l <= 0.0 {
         return Err(Error::InvalidInput(
             "point segmentation: the points are all coincident".into(),
         ));

@@ -503,8 +503,17 @@ struct GridSearch<'a> {
     /// Whether the neighbours must come nearest first (false: the set in an unspecified but
     /// deterministic order, see [`knn_map_set`]).
     ordered: bool,
+    /// Whether the f32 block search is safe at this cell size (see [`BLOCK_CELL_RANGE`]).
+    blocks: bool,
     fallback: OnceLock<Option<KdIndex>>,
 }
+
+/// Cell sides for which the f32 block search of [`block_query`] holds: its squared distances
+/// (up to about 27 cell² within a block) must neither overflow f32 nor fall into its subnormal
+/// range. Outside (a cloud spaced 1e19 apart, or 1e-30), the shell search in f64 answers every
+/// query: slower, exact. Seen by a fuzzer: a 25-point grid spaced 1e19 overflowed to infinite
+/// distances and indexed out of bounds.
+const BLOCK_CELL_RANGE: (f64, f64) = (1e-15, 1e17);
 
 impl<'a> GridSearch<'a> {
     /// Sorts and buckets `points` (arguments already checked).
@@ -519,11 +528,13 @@ impl<'a> GridSearch<'a> {
             .with_cell(r * CELL_RATIO)
             .unwrap_or_else(|| (quant, level_for(&quant, r * CELL_RATIO)));
         let grid = CellGrid::new(points, quant, &cell_sorted(points, &quant, level), level);
+        let blocks = (BLOCK_CELL_RANGE.0..=BLOCK_CELL_RANGE.1).contains(&grid.cell_size);
         Ok(GridSearch {
             points,
             grid,
             k,
             ordered: true,
+            blocks,
             fallback: OnceLock::new(),
         })
     }
@@ -535,7 +546,7 @@ impl<'a> GridSearch<'a> {
         scratch.ids.clear();
         scratch.d2.clear();
         scratch.pts.clear();
-        if block_query(&self.grid, r, k, self.ordered, scratch) {
+        if self.blocks && block_query(&self.grid, r, k, self.ordered, scratch) {
             if self.ordered {
                 self.copy_sel(scratch);
             }
