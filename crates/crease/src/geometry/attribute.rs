@@ -160,6 +160,38 @@ impl Attributes {
         Ok(())
     }
 
+    /// Adds many attributes at once, each replacing an attribute of the same name (a later one
+    /// of `attrs` wins over an earlier one): linear in their number, where one [`insert`] after
+    /// another is quadratic (a text file of 100,000 columns took 81 s to read).
+    ///
+    /// [`insert`]: Attributes::insert
+    pub fn extend(&mut self, len: usize, attrs: Vec<Attribute>) -> Result<()> {
+        if let Some(a) = attrs.iter().find(|a| a.values.len() != len) {
+            return Err(Error::InvalidArgument(format!(
+                "attribute {:?} has {} values for {} elements",
+                a.name,
+                a.values.len(),
+                len
+            )));
+        }
+        let mut index: std::collections::HashMap<String, usize> = self
+            .items
+            .iter()
+            .enumerate()
+            .map(|(i, a)| (a.name.clone(), i))
+            .collect();
+        for attr in attrs {
+            match index.get(&attr.name) {
+                Some(&i) => self.items[i] = attr,
+                None => {
+                    index.insert(attr.name.clone(), self.items.len());
+                    self.items.push(attr);
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Removes and returns the attribute named `name`.
     pub fn remove(&mut self, name: &str) -> Option<Attribute> {
         let i = self.items.iter().position(|a| a.name == name)?;
@@ -214,5 +246,35 @@ impl<'a> IntoIterator for &'a Attributes {
     type IntoIter = std::slice::Iter<'a, Attribute>;
     fn into_iter(self) -> Self::IntoIter {
         self.items.iter()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `extend` is `insert` after `insert`: a name already there keeps its place and takes the
+    /// new values, a later duplicate wins, a wrong length is an error that changes nothing.
+    #[test]
+    fn extend_equals_repeated_inserts() {
+        let a = |name: &str, v: f64| Attribute::float(name, vec![v; 2]);
+        let batch = vec![a("b", 2.0), a("c", 3.0), a("a", 4.0), a("c", 5.0)];
+        let mut one = Attributes::new();
+        one.insert(2, a("a", 1.0)).expect("insert");
+        let mut many = one.clone();
+        for x in batch.clone() {
+            one.insert(2, x).expect("insert");
+        }
+        many.extend(2, batch).expect("extend");
+        assert_eq!(one, many);
+        let names: Vec<&str> = many.iter().map(|x| x.name.as_str()).collect();
+        assert_eq!(names, ["a", "b", "c"]);
+        assert_eq!(many.get("c").expect("c").values, vec![5.0; 2]);
+        let before = many.clone();
+        assert!(many.extend(2, vec![a("d", 1.0), a("e", 1.0)]).is_ok());
+        let mut bad = before.clone();
+        let short = Attribute::float("f", vec![1.0]);
+        assert!(bad.extend(2, vec![a("g", 1.0), short]).is_err());
+        assert_eq!(bad, before);
     }
 }

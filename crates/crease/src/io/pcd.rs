@@ -907,6 +907,7 @@ fn decode(
         used[fc] = true;
     }
     let mut wide = false;
+    let mut fields = Vec::new();
     for (fi, f) in h.fields.iter().enumerate() {
         if used[fi] || f.name == "_" {
             continue;
@@ -928,13 +929,15 @@ fn decode(
             } else {
                 format!("{}_{c}", f.name)
             };
-            cloud.set_attribute(Attribute {
+            fields.push(Attribute {
                 name,
                 kind,
                 values: column(fi, c),
-            })?;
+            });
         }
     }
+    let n = cloud.len();
+    cloud.attributes.extend(n, fields)?;
     if wide {
         report.notes.push(
             "8-byte integer fields are stored as F64 attributes (exact up to 2^53)".to_string(),

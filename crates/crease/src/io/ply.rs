@@ -1050,20 +1050,19 @@ fn kind_of(el: &ElementDef, i: usize) -> ScalarKind {
 
 /// Every remaining scalar column as a named attribute, in header order.
 fn remaining_attributes(el: &ElementDef, cols: &mut [Col], n: usize) -> Result<Attributes> {
-    let mut attrs = Attributes::new();
+    let mut found = Vec::new();
     for (i, p) in el.props.iter().enumerate() {
         if let Some(Col::Scalar(_) | Col::Raw(_)) = cols.get(i) {
             let values = take_scalar(cols, i);
-            attrs.insert(
-                n,
-                Attribute {
-                    name: p.name.clone(),
-                    kind: kind_of(el, i),
-                    values,
-                },
-            )?;
+            found.push(Attribute {
+                name: p.name.clone(),
+                kind: kind_of(el, i),
+                values,
+            });
         }
     }
+    let mut attrs = Attributes::new();
+    attrs.extend(n, found)?;
     Ok(attrs)
 }
 

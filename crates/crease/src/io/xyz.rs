@@ -198,7 +198,15 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Geometry, ReadReport)>
         }
     }
 
-    let column = |j: usize| -> Vec<f64> { values.par_chunks_exact(ncols).map(|r| r[j]).collect() };
+    // One column (in parallel only for long files: a file of many columns and few rows spent
+    // its time starting rayon tasks, one per column).
+    let column = |j: usize| -> Vec<f64> {
+        if values.len() / ncols.max(1) < 1 << 16 {
+            values.chunks_exact(ncols).map(|r| r[j]).collect()
+        } else {
+            values.par_chunks_exact(ncols).map(|r| r[j]).collect()
+        }
+    };
     let positions: Vec<[f64; 3]> = values
         .par_chunks_exact(ncols)
         .map(|r| [r[0], r[1], r[2]])
@@ -296,12 +304,16 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Geometry, ReadReport)>
             "r g b (0..255)".into()
         });
     }
+    let mut columns = Vec::with_capacity(attrs.len());
     for (j, name) in &attrs {
         roles.push(name.clone());
-        cloud
-            .set_attribute(Attribute::float(name.clone(), column(*j)))
-            .map_err(|e| Error::format(path, e.to_string()))?;
+        columns.push(Attribute::float(name.clone(), column(*j)));
     }
+    let n = cloud.len();
+    cloud
+        .attributes
+        .extend(n, columns)
+        .map_err(|e| Error::format(path, e.to_string()))?;
     report.encoding = format!("ascii, {ncols} columns");
     if ncols > 3 {
         report.notes.push(format!(
