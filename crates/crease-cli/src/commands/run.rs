@@ -21,7 +21,7 @@ use anyhow::Context;
 use clap::Args;
 use crease::analysis::{AnalysisParams, CloudAnalysis};
 use crease::fillets::{curve_network, extract_fillets_from, FilletParams, Label};
-use crease::geometry::{names, Attribute, MeshTopology, PointCloud, ScalarKind, TriMesh};
+use crease::geometry::{names, Attribute, PointCloud, ScalarKind, TriMesh};
 use crease::io::Geometry;
 use crease::meshfeat::{detect_edges, feature_polylines, EdgeParams};
 use crease::render::{ColorBy, Polyline, RenderParams, Scene};
@@ -207,12 +207,11 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
     timings.insert("feature_edges".into(), serde_json::json!(s.finish()));
     let edges = em.topo.edges().to_vec();
     let lines = feature_polylines(&em.topo, &det.sharp);
-    drop(em);
+    // The segmentation reads the edge topology the feature edges were computed on.
     let s = Stage::start("segmentation into analytic surfaces", g.quiet);
-    let topo = MeshTopology::new(&mesh).with_context(|| name.clone())?;
     let seg =
-        segment_mesh(&mesh, &topo, &SegmentParams::default()).with_context(|| name.clone())?;
-    drop(topo);
+        segment_mesh(&mesh, &em.topo, &SegmentParams::default()).with_context(|| name.clone())?;
+    drop(em);
     timings.insert("segmentation".into(), serde_json::json!(s.finish()));
 
     mesh.set_face_attribute(Attribute::int(

@@ -200,11 +200,7 @@ pub fn signed_distance(s: &SurfaceParams, p: Point3) -> f64 {
             apex,
             axis_dir,
             half_angle,
-        } => {
-            let [rho, h] = meridian(p, apex, axis_dir);
-            let (s, c) = half_angle.sin_cos();
-            rho * c - h * s
-        }
+        } => cone_distance(p, apex, axis_dir, half_angle.sin_cos()),
         SurfaceParams::Torus {
             center,
             axis_dir,
@@ -220,20 +216,6 @@ pub fn signed_distance(s: &SurfaceParams, p: Point3) -> f64 {
 /// Unit normal of the surface at the point nearest to `p` (outward for the closed types and
 /// the cylinder, away from the axis for the cone). Zero where undefined (on the axis).
 pub fn surface_normal(s: &SurfaceParams, p: Point3) -> Point3 {
-    let radial = |v: Point3, d: Point3| -> (Point3, f64, f64) {
-        let h = dot(v, d);
-        let r = sub(v, scale(d, h));
-        let rho = norm(r);
-        (
-            if rho > 0.0 {
-                scale(r, 1.0 / rho)
-            } else {
-                [0.0; 3]
-            },
-            rho,
-            h,
-        )
-    };
     match *s {
         SurfaceParams::Plane { normal, .. } => normal,
         SurfaceParams::Cylinder {
@@ -246,11 +228,7 @@ pub fn surface_normal(s: &SurfaceParams, p: Point3) -> Point3 {
             apex,
             axis_dir,
             half_angle,
-        } => {
-            let (u, _, _) = radial(sub(p, apex), axis_dir);
-            let (s, c) = half_angle.sin_cos();
-            sub(scale(u, c), scale(axis_dir, s))
-        }
+        } => cone_normal(p, apex, axis_dir, half_angle.sin_cos()),
         SurfaceParams::Torus {
             center,
             axis_dir,
@@ -261,6 +239,37 @@ pub fn surface_normal(s: &SurfaceParams, p: Point3) -> Point3 {
             normalize(add(scale(u, rho - major_radius), scale(axis_dir, h))).unwrap_or([0.0; 3])
         }
     }
+}
+
+/// Unit direction of `v` away from the axis along the unit `d`, its distance from the axis
+/// and its height along it.
+fn radial(v: Point3, d: Point3) -> (Point3, f64, f64) {
+    let h = dot(v, d);
+    let r = sub(v, scale(d, h));
+    let rho = norm(r);
+    (
+        if rho > 0.0 {
+            scale(r, 1.0 / rho)
+        } else {
+            [0.0; 3]
+        },
+        rho,
+        h,
+    )
+}
+
+/// The cone's signed distance with `(sin, cos)` of its half angle given.
+#[inline]
+fn cone_distance(p: Point3, apex: Point3, axis_dir: Point3, (s, c): (f64, f64)) -> f64 {
+    let [rho, h] = meridian(p, apex, axis_dir);
+    rho * c - h * s
+}
+
+/// The cone's normal with `(sin, cos)` of its half angle given.
+#[inline]
+fn cone_normal(p: Point3, apex: Point3, axis_dir: Point3, (s, c): (f64, f64)) -> Point3 {
+    let (u, _, _) = radial(sub(p, apex), axis_dir);
+    sub(scale(u, c), scale(axis_dir, s))
 }
 
 /// A surface with its per-surface constants computed once (the cone's sine and cosine of its
@@ -299,8 +308,7 @@ impl Prepared {
     pub fn signed_distance(&self, p: Point3) -> f64 {
         match self.surface {
             SurfaceParams::Cone { apex, axis_dir, .. } => {
-                let [rho, h] = meridian(p, apex, axis_dir);
-                rho * self.cos - h * self.sin
+                cone_distance(p, apex, axis_dir, (self.sin, self.cos))
             }
             ref s => signed_distance(s, p),
         }
@@ -311,16 +319,7 @@ impl Prepared {
     pub fn normal(&self, p: Point3) -> Point3 {
         match self.surface {
             SurfaceParams::Cone { apex, axis_dir, .. } => {
-                let v = sub(p, apex);
-                let h = dot(v, axis_dir);
-                let r = sub(v, scale(axis_dir, h));
-                let rho = norm(r);
-                let u = if rho > 0.0 {
-                    scale(r, 1.0 / rho)
-                } else {
-                    [0.0; 3]
-                };
-                sub(scale(u, self.cos), scale(axis_dir, self.sin))
+                cone_normal(p, apex, axis_dir, (self.sin, self.cos))
             }
             ref s => surface_normal(s, p),
         }

@@ -345,7 +345,6 @@ fn check_scales(scales: &[usize], what: &str) -> Result<()> {
 ///
 /// Errors: fewer points than the largest k + 1, non-finite coordinates, invalid parameters.
 pub fn detect_points(points: &[Point3], params: &SharpParams) -> Result<SharpResult> {
-    params.validate()?;
     let scales = params
         .scales
         .clone()
