@@ -243,7 +243,7 @@ pub fn surface_normal(s: &SurfaceParams, p: Point3) -> Point3 {
 
 /// Unit direction of `v` away from the axis along the unit `d`, its distance from the axis
 /// and its height along it.
-fn radial(v: Point3, d: Point3) -> (Point3, f64, f64) {
+pub(crate) fn radial(v: Point3, d: Point3) -> (Point3, f64, f64) {
     let h = dot(v, d);
     let r = sub(v, scale(d, h));
     let rho = norm(r);
@@ -276,7 +276,7 @@ fn cone_normal(p: Point3, apex: Point3, axis_dir: Point3, (s, c): (f64, f64)) ->
 /// half angle), for loops over many points: [`Prepared::signed_distance`] equals
 /// [`signed_distance`] and [`Prepared::normal`] [`surface_normal`] bit for bit. Measured on a 9.7k-point scan (`scans/curvsurf`), the
 /// per-point `sin_cos` of the cone's distance was half the segmentation's time, in the
-/// Levenberg–Marquardt refinements that evaluate every residual 2N + 1 times an iteration.
+/// Levenberg–Marquardt refinements, which then evaluated every residual 2N + 1 times an iteration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Prepared {
     surface: SurfaceParams,

@@ -26,14 +26,14 @@
 //! refined by Levenberg–Marquardt on the orthogonal (geometric) distances, with at most
 //! [`LM_MAX_POINTS`] points (an even, deterministic subsample of bigger regions). The plane's
 //! geometric least-squares optimum is closed form (the weighted PCA plane). The LM is written
-//! here (about 80 lines on nalgebra fixed-size matrices with central-difference Jacobians)
+//! here (about 80 lines on nalgebra fixed-size matrices, with each type's analytic Jacobian:
+//! one distance evaluation per point and iteration where central differences took 2N + 1)
 //! rather than taken from the `levenberg-marquardt` crate, whose API wants a dynamic Jacobian
 //! matrix of all residuals (memory of n × p per iteration) and its own nalgebra version.
 //!
 //! **Units.** Nothing in the fits is absolute: the LM parameters have natural sizes (the
-//! patch's extent for lengths, 1 for directions and angles) from which its central-difference
-//! steps (1e-6 of them) and the floor of its damping (`damping_floor`) are taken, it stops at
-//! a relative decrease of the cost, the restarts of [`refine`] compare relative RMS gains, and
+//! patch's extent for lengths, 1 for directions and angles) from which the floor of its
+//! damping (`damping_floor`) is taken, it stops at relative decreases of the cost, the restarts of [`refine`] compare relative RMS gains, and
 //! the algebraic circle, sphere and quadric fits, whose normal equations mix `x²`, `x` and 1,
 //! are solved in units of the data's RMS radius (`unit_scale`). So a fit in other units is
 //! the same fit scaled: bit for bit when the factor is a power of two, up to round-off
@@ -42,7 +42,7 @@
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector3};
 use rayon::prelude::*;
 
-use crate::geometry::surface::{meridian, signed_distance, Prepared};
+use crate::geometry::surface::{meridian, radial, signed_distance, Prepared};
 use crate::geometry::vec3::{add, cross, dist2, dot, norm, normalize, scale, sub};
 use crate::geometry::{Point3, SurfaceParams, SurfaceType};
 
@@ -52,6 +52,26 @@ pub const LM_MAX_POINTS: usize = 20_000;
 
 /// Largest number of Levenberg–Marquardt iterations.
 pub const LM_MAX_ITERATIONS: usize = 300;
+
+/// The LM stops when one step lowers the cost by less than this fraction of it (MINPACK's
+/// `ftol`, whose default is about 1.5e-8).
+const LM_COST_TOLERANCE: f64 = 1e-10;
+
+/// The LM stops when the last [`LM_STALL_ITERATIONS`] steps together lowered the cost by less
+/// than this fraction (the RMS error by less than half of it): a run creeping along a flat
+/// valley, typically a few-point seed fitted with a type it hardly determines (a cone to
+/// seven points whose half angle and axis trade off), which otherwise ran to the iteration
+/// cap for fits that no decision reads to a millionth.
+const LM_STALL_DECREASE: f64 = 1e-6;
+
+/// The LM stops when the RMS distance falls below this fraction of the patch's size (the
+/// diagonal of its bounding box): the fit passes through the points, down to the round-off of
+/// their coordinates (exact data, and seeds of no more points than the surface's parameters,
+/// whose runs otherwise went on lowering a cost of 1e-38 by relative steps of round-off).
+const LM_SETTLED_RMS: f64 = 1e-12;
+
+/// See [`LM_STALL_DECREASE`].
+const LM_STALL_ITERATIONS: usize = 20;
 
 /// A fitted surface and its fit quality on the points it was fitted to.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -523,34 +543,26 @@ pub fn refine(init: &SurfaceParams, pts: &[Point3], w: &[f64]) -> Option<Surface
 }
 
 fn refine_once(init: &SurfaceParams, sp: &[Point3], sw: &[f64]) -> Option<SurfaceParams> {
-    if let SurfaceParams::Plane { .. } = init {
-        return plane_refine(init, sp, sw);
-    }
     let ext = extent(sp)?;
     let out = match *init {
         SurfaceParams::Plane { .. } => return plane_refine(init, sp, sw),
         SurfaceParams::Sphere { center, radius } => {
-            let f = |x: &[f64; 4]| SurfaceParams::Sphere {
-                center: add(center, [x[0], x[1], x[2]]),
-                radius: radius + x[3],
-            };
-            let x = lm([0.0; 4], [ext, ext, ext, ext], sp, sw, |x| f(x))?;
-            f(&x)
+            let m = SphereModel { center, radius };
+            let x = lm(&m, ext, [ext, ext, ext, ext], sp, sw)?;
+            m.at(&x).surface()
         }
         SurfaceParams::Cylinder {
             axis_point,
             axis_dir,
             radius,
         } => {
-            let (u, v) = frame_of(axis_dir);
-            let f = |x: &[f64; 5]| SurfaceParams::Cylinder {
-                axis_point: add(add(axis_point, scale(u, x[0])), scale(v, x[1])),
-                axis_dir: normalize(add(add(axis_dir, scale(u, x[2])), scale(v, x[3])))
-                    .unwrap_or(axis_dir),
-                radius: radius + x[4],
+            let m = CylinderModel {
+                axis_point,
+                axis: Axis::new(axis_dir),
+                radius,
             };
-            let x = lm([0.0; 5], [ext, ext, 1.0, 1.0, ext], sp, sw, |x| f(x))?;
-            f(&x)
+            let x = lm(&m, ext, [ext, ext, 1.0, 1.0, ext], sp, sw)?;
+            m.at(&x).surface()
         }
         SurfaceParams::Cone {
             apex,
@@ -564,23 +576,14 @@ fn refine_once(init: &SurfaceParams, sp: &[Point3], sw: &[f64]) -> Option<Surfac
             // iterations).
             let c = centroid(sp, sw)?;
             let hc = dot(sub(c, apex), axis_dir);
-            let p0 = add(apex, scale(axis_dir, hc));
-            let r0 = hc * half_angle.tan();
-            let (u, v) = frame_of(axis_dir);
-            let f = |x: &[f64; 6]| {
-                let d = normalize(add(add(axis_dir, scale(u, x[2])), scale(v, x[3])))
-                    .unwrap_or(axis_dir);
-                let q = add(add(p0, scale(u, x[0])), scale(v, x[1]));
-                let th = half_angle + x[5];
-                let r = r0 + x[4];
-                SurfaceParams::Cone {
-                    apex: sub(q, scale(d, r / th.tan())),
-                    axis_dir: d,
-                    half_angle: th,
-                }
+            let m = ConeModel {
+                axis_point: add(apex, scale(axis_dir, hc)),
+                axis: Axis::new(axis_dir),
+                radius: hc * half_angle.tan(),
+                half_angle,
             };
-            let x = lm([0.0; 6], [ext, ext, 1.0, 1.0, ext, 1.0], sp, sw, |x| f(x))?;
-            f(&x)
+            let x = lm(&m, ext, [ext, ext, 1.0, 1.0, ext, 1.0], sp, sw)?;
+            m.at(&x).surface()
         }
         SurfaceParams::Torus {
             center,
@@ -588,22 +591,317 @@ fn refine_once(init: &SurfaceParams, sp: &[Point3], sw: &[f64]) -> Option<Surfac
             major_radius,
             minor_radius,
         } => {
-            let (u, v) = frame_of(axis_dir);
-            let f = |x: &[f64; 7]| SurfaceParams::Torus {
-                center: add(center, [x[0], x[1], x[2]]),
-                axis_dir: normalize(add(add(axis_dir, scale(u, x[3])), scale(v, x[4])))
-                    .unwrap_or(axis_dir),
-                major_radius: major_radius + x[5],
-                minor_radius: minor_radius + x[6],
+            let m = TorusModel {
+                center,
+                axis: Axis::new(axis_dir),
+                major_radius,
+                minor_radius,
             };
-            let x = lm([0.0; 7], [ext, ext, ext, 1.0, 1.0, ext, ext], sp, sw, |x| {
-                f(x)
-            })?;
-            f(&x)
+            let x = lm(&m, ext, [ext, ext, ext, 1.0, 1.0, ext, ext], sp, sw)?;
+            m.at(&x).surface()
         }
     };
     let out = canonical(out, sp, sw);
     finite(&out).then_some(out)
+}
+
+/// A parametrisation of one surface type around its initial estimate, for [`lm`]: `x = 0` is
+/// the estimate; [`Model::at`] gives the surface at `x`, whose [`Linearised::row`] is a point's
+/// signed distance ([`signed_distance`]) with its gradient in `x` (one row of the Jacobian).
+trait Model<const N: usize>: Sync {
+    /// The surface at the parameters `x`, with what its Jacobian rows share.
+    type At: Linearised<N>;
+    /// The surface at `x`.
+    fn at(&self, x: &[f64; N]) -> Self::At;
+}
+
+/// A surface at given parameters, with its Jacobian rows (see [`Model`]).
+trait Linearised<const N: usize>: Sync {
+    /// The surface.
+    fn surface(&self) -> SurfaceParams;
+    /// Signed distance of `p` and its gradient in the parameters.
+    fn row(&self, p: Point3) -> (f64, SVector<f64, N>);
+}
+
+/// An axis direction parametrised by two tilts along the frame `(u, v)` of its initial
+/// direction `d0`: `d(x) = (d0 + x_u u + x_v v) / |…|`. A function of `d` changes with a tilt
+/// by `(∂f/∂d)ᵀ (I − d dᵀ) u / |…|` (the derivative of the normalisation).
+#[derive(Debug, Clone, Copy)]
+struct Axis {
+    d0: Point3,
+    u: Point3,
+    v: Point3,
+}
+
+impl Axis {
+    fn new(d0: Point3) -> Axis {
+        let (u, v) = frame_of(d0);
+        Axis { d0, u, v }
+    }
+
+    /// The direction at tilts `(a, b)` and `1 / |d0 + a u + b v|`.
+    fn at(&self, a: f64, b: f64) -> (Point3, f64) {
+        let m = add(add(self.d0, scale(self.u, a)), scale(self.v, b));
+        let len = norm(m);
+        if len > 0.0 && len.is_finite() {
+            (scale(m, 1.0 / len), 1.0 / len)
+        } else {
+            (self.d0, 1.0)
+        }
+    }
+}
+
+/// Sphere: centre offset (3), radius offset.
+struct SphereModel {
+    center: Point3,
+    radius: f64,
+}
+
+struct SphereAt {
+    center: Point3,
+    radius: f64,
+}
+
+impl Model<4> for SphereModel {
+    type At = SphereAt;
+    fn at(&self, x: &[f64; 4]) -> SphereAt {
+        SphereAt {
+            center: add(self.center, [x[0], x[1], x[2]]),
+            radius: self.radius + x[3],
+        }
+    }
+}
+
+impl Linearised<4> for SphereAt {
+    fn surface(&self) -> SurfaceParams {
+        SurfaceParams::Sphere {
+            center: self.center,
+            radius: self.radius,
+        }
+    }
+    /// `d = |p − c| − r`: `∂d/∂c = −n`, `∂d/∂r = −1`.
+    fn row(&self, p: Point3) -> (f64, SVector<f64, 4>) {
+        let w = sub(p, self.center);
+        let len = norm(w);
+        let n = if len > 0.0 {
+            scale(w, 1.0 / len)
+        } else {
+            [0.0; 3]
+        };
+        (
+            len - self.radius,
+            SVector::<f64, 4>::new(-n[0], -n[1], -n[2], -1.0),
+        )
+    }
+}
+
+/// Cylinder: axis point offset along the frame (2), axis tilts (2), radius offset.
+struct CylinderModel {
+    axis_point: Point3,
+    axis: Axis,
+    radius: f64,
+}
+
+struct CylinderAt {
+    axis_point: Point3,
+    dir: Point3,
+    inv_len: f64,
+    radius: f64,
+    u: Point3,
+    v: Point3,
+}
+
+impl Model<5> for CylinderModel {
+    type At = CylinderAt;
+    fn at(&self, x: &[f64; 5]) -> CylinderAt {
+        let (u, v) = (self.axis.u, self.axis.v);
+        let (dir, inv_len) = self.axis.at(x[2], x[3]);
+        CylinderAt {
+            axis_point: add(add(self.axis_point, scale(u, x[0])), scale(v, x[1])),
+            dir,
+            inv_len,
+            radius: self.radius + x[4],
+            u,
+            v,
+        }
+    }
+}
+
+impl Linearised<5> for CylinderAt {
+    fn surface(&self) -> SurfaceParams {
+        SurfaceParams::Cylinder {
+            axis_point: self.axis_point,
+            axis_dir: self.dir,
+            radius: self.radius,
+        }
+    }
+    /// `d = ρ − r` with `w = p − a`, `h = w·d̂`, `ρ = |w − h d̂|` along the unit `ρ̂`:
+    /// `∂d/∂a = −ρ̂`, `∂d/∂d̂ = −h ρ̂`, `∂d/∂r = −1`.
+    fn row(&self, p: Point3) -> (f64, SVector<f64, 5>) {
+        let (rh, rho, h) = radial(sub(p, self.axis_point), self.dir);
+        let (ru, rv) = (dot(rh, self.u), dot(rh, self.v));
+        let t = -h * self.inv_len;
+        (
+            rho - self.radius,
+            SVector::<f64, 5>::new(-ru, -rv, t * ru, t * rv, -1.0),
+        )
+    }
+}
+
+/// Cone: the axis point level with the patch's centroid offset along the frame (2), axis
+/// tilts (2), the radius there and the half angle (offsets); the apex is
+/// `q − d̂ r / tan θ`.
+struct ConeModel {
+    axis_point: Point3,
+    axis: Axis,
+    radius: f64,
+    half_angle: f64,
+}
+
+struct ConeAt {
+    apex: Point3,
+    dir: Point3,
+    inv_len: f64,
+    half_angle: f64,
+    sin: f64,
+    cos: f64,
+    /// `r / tan θ`: the apex's distance from the axis point.
+    back: f64,
+    radius: f64,
+    u: Point3,
+    v: Point3,
+}
+
+impl Model<6> for ConeModel {
+    type At = ConeAt;
+    fn at(&self, x: &[f64; 6]) -> ConeAt {
+        let (u, v) = (self.axis.u, self.axis.v);
+        let (dir, inv_len) = self.axis.at(x[2], x[3]);
+        let q = add(add(self.axis_point, scale(u, x[0])), scale(v, x[1]));
+        let half_angle = self.half_angle + x[5];
+        let radius = self.radius + x[4];
+        let back = radius / half_angle.tan();
+        let (sin, cos) = half_angle.sin_cos();
+        ConeAt {
+            apex: sub(q, scale(dir, back)),
+            dir,
+            inv_len,
+            half_angle,
+            sin,
+            cos,
+            back,
+            radius,
+            u,
+            v,
+        }
+    }
+}
+
+impl Linearised<6> for ConeAt {
+    fn surface(&self) -> SurfaceParams {
+        SurfaceParams::Cone {
+            apex: self.apex,
+            axis_dir: self.dir,
+            half_angle: self.half_angle,
+        }
+    }
+    /// `d = ρ cos θ − h sin θ` with `w = p − apex`, `h = w·d̂`, `ρ = |w − h d̂|` along `ρ̂`, and
+    /// `n = cos θ ρ̂ − sin θ d̂`. Through `apex = q − b d̂` (`b = r / tan θ`):
+    /// `∂d/∂q = −n`, `∂d/∂r = −cos θ`, `∂d/∂θ = −ρ sin θ − h cos θ + r / sin θ`, and along a
+    /// tilt `(−h cos θ − ρ sin θ + b cos θ) ρ̂`.
+    fn row(&self, p: Point3) -> (f64, SVector<f64, 6>) {
+        let (s, c) = (self.sin, self.cos);
+        let (rh, rho, h) = radial(sub(p, self.apex), self.dir);
+        let n = sub(scale(rh, c), scale(self.dir, s));
+        let (ru, rv) = (dot(rh, self.u), dot(rh, self.v));
+        let t = (-h * c - rho * s + self.back * c) * self.inv_len;
+        (
+            rho * c - h * s,
+            SVector::<f64, 6>::new(
+                -dot(n, self.u),
+                -dot(n, self.v),
+                t * ru,
+                t * rv,
+                -c,
+                -rho * s - h * c + self.radius / s,
+            ),
+        )
+    }
+}
+
+/// Torus: centre offset (3), axis tilts (2), major and minor radius offsets.
+struct TorusModel {
+    center: Point3,
+    axis: Axis,
+    major_radius: f64,
+    minor_radius: f64,
+}
+
+struct TorusAt {
+    center: Point3,
+    dir: Point3,
+    inv_len: f64,
+    major_radius: f64,
+    minor_radius: f64,
+    u: Point3,
+    v: Point3,
+}
+
+impl Model<7> for TorusModel {
+    type At = TorusAt;
+    fn at(&self, x: &[f64; 7]) -> TorusAt {
+        let (dir, inv_len) = self.axis.at(x[3], x[4]);
+        TorusAt {
+            center: add(self.center, [x[0], x[1], x[2]]),
+            dir,
+            inv_len,
+            major_radius: self.major_radius + x[5],
+            minor_radius: self.minor_radius + x[6],
+            u: self.axis.u,
+            v: self.axis.v,
+        }
+    }
+}
+
+impl Linearised<7> for TorusAt {
+    fn surface(&self) -> SurfaceParams {
+        SurfaceParams::Torus {
+            center: self.center,
+            axis_dir: self.dir,
+            major_radius: self.major_radius,
+            minor_radius: self.minor_radius,
+        }
+    }
+    /// `d = √((ρ − R)² + h²) − r` with `w = p − c`, `h = w·d̂`, `ρ = |w − h d̂|` along `ρ̂`, and
+    /// the unit `n = ((ρ − R) ρ̂ + h d̂) / √…`: `∂d/∂c = −n`, `∂d/∂R = −(ρ − R) / √…`,
+    /// `∂d/∂r = −1`, and along a tilt `(h R / √…) ρ̂`.
+    fn row(&self, p: Point3) -> (f64, SVector<f64, 7>) {
+        let (rh, rho, h) = radial(sub(p, self.center), self.dir);
+        let e = rho - self.major_radius;
+        let len = e.hypot(h);
+        let (n, de, t) = if len > 0.0 {
+            let k = 1.0 / len;
+            (
+                add(scale(rh, e * k), scale(self.dir, h * k)),
+                e * k,
+                h * self.major_radius * k * self.inv_len,
+            )
+        } else {
+            ([0.0; 3], 0.0, 0.0)
+        };
+        (
+            len - self.minor_radius,
+            SVector::<f64, 7>::from_column_slice(&[
+                -n[0],
+                -n[1],
+                -n[2],
+                t * dot(rh, self.u),
+                t * dot(rh, self.v),
+                -de,
+                -1.0,
+            ]),
+        )
+    }
 }
 
 /// Puts a refined surface in its canonical form: cylinder axis point nearest the centroid,
@@ -642,8 +940,7 @@ fn canonical(s: SurfaceParams, pts: &[Point3], w: &[f64]) -> SurfaceParams {
 }
 
 /// Diagonal of the points' bounding box: the natural size of the length parameters of the
-/// refinement (their central-difference steps are 1e-6 of it). `None` when the points
-/// coincide (no step size; the refinement is skipped). No absolute floor: it was 1e-12 model
+/// refinement. `None` when the points coincide (the refinement is skipped). No absolute floor: it was 1e-12 model
 /// units, which a region a few nanometres across in metres would have reached.
 fn extent(pts: &[Point3]) -> Option<f64> {
     let mut lo = [f64::MAX; 3];
@@ -703,19 +1000,20 @@ fn damping_floor<const N: usize>(jtj: &SMatrix<f64, N, N>, scales: &[f64; N]) ->
     out
 }
 
-/// Levenberg–Marquardt on the signed orthogonal distances of `pts` to `surf(x)`, starting at
-/// `x0`; `scales` are the parameters' natural sizes (central-difference steps are 1e-6 of
-/// them). Normal equations accumulated over fixed chunks and summed in order, so the result
-/// does not depend on the thread count. `None` if no step improved the initial cost.
-fn lm<const N: usize>(
-    x0: [f64; N],
+/// Levenberg–Marquardt on the signed orthogonal distances of `pts` to the surface of `model`,
+/// starting at `x = 0` (the initial estimate), with analytic Jacobians ([`Linearised::row`]);
+/// `scales` are the parameters' natural sizes (for the floor of the damping). Normal equations
+/// accumulated over fixed chunks and summed in order, so the result does not depend on the
+/// thread count. `None` if no step improved the initial cost.
+fn lm<const N: usize, M: Model<N>>(
+    model: &M,
+    size: f64,
     scales: [f64; N],
     pts: &[Point3],
     w: &[f64],
-    surf: impl Fn(&[f64; N]) -> SurfaceParams + Sync,
 ) -> Option<[f64; N]> {
     let cost = |x: &[f64; N]| -> f64 {
-        let s = Prepared::new(&surf(x));
+        let s = Prepared::new(&model.at(x).surface());
         let parts: Vec<f64> = pts
             .par_chunks(2048)
             .zip(w.par_chunks(2048))
@@ -732,20 +1030,7 @@ fn lm<const N: usize>(
         parts.into_iter().sum()
     };
     let normal_eq = |x: &[f64; N]| -> (SMatrix<f64, N, N>, SVector<f64, N>) {
-        let base = Prepared::new(&surf(x));
-        let mut plus = Vec::with_capacity(N);
-        let mut minus = Vec::with_capacity(N);
-        let mut steps = [0.0; N];
-        for j in 0..N {
-            let h = 1e-6 * scales[j];
-            steps[j] = h;
-            let mut xp = *x;
-            xp[j] += h;
-            plus.push(Prepared::new(&surf(&xp)));
-            let mut xm = *x;
-            xm[j] -= h;
-            minus.push(Prepared::new(&surf(&xm)));
-        }
+        let at = model.at(x);
         let parts: Vec<(SMatrix<f64, N, N>, SVector<f64, N>)> = pts
             .par_chunks(2048)
             .zip(w.par_chunks(2048))
@@ -753,12 +1038,7 @@ fn lm<const N: usize>(
                 let mut jtj = SMatrix::<f64, N, N>::zeros();
                 let mut jtr = SVector::<f64, N>::zeros();
                 for (&p, &wi) in p.iter().zip(w) {
-                    let r = base.signed_distance(p);
-                    let mut g = SVector::<f64, N>::zeros();
-                    for j in 0..N {
-                        g[j] = (plus[j].signed_distance(p) - minus[j].signed_distance(p))
-                            / (2.0 * steps[j]);
-                    }
+                    let (r, g) = at.row(p);
                     jtj += g * g.transpose() * wi;
                     jtr += g * (r * wi);
                 }
@@ -773,14 +1053,27 @@ fn lm<const N: usize>(
         }
         (jtj, jtr)
     };
-    let mut x = x0;
+    let mut x = [0.0; N];
     let mut c = cost(&x);
     if !c.is_finite() {
         return None;
     }
     let c0 = c;
+    let settled = (LM_SETTLED_RMS * size).powi(2) * w.iter().sum::<f64>();
     let mut lambda = 1e-3;
-    for _ in 0..LM_MAX_ITERATIONS {
+    // The cost at the start of every iteration, for the stall test.
+    let mut history: Vec<f64> = Vec::new();
+    for it in 0..LM_MAX_ITERATIONS {
+        if c <= settled {
+            break;
+        }
+        history.push(c);
+        if it >= LM_STALL_ITERATIONS {
+            let before = history[it - LM_STALL_ITERATIONS];
+            if before - c < LM_STALL_DECREASE * before {
+                break;
+            }
+        }
         let (jtj, jtr) = normal_eq(&x);
         let floor = damping_floor(&jtj, &scales);
         let mut improved = false;
@@ -804,7 +1097,7 @@ fn lm<const N: usize>(
                 c = cn;
                 lambda = (lambda * 0.3).max(1e-12);
                 improved = true;
-                if rel < 1e-13 {
+                if rel < LM_COST_TOLERANCE {
                     return Some(x);
                 }
                 break;
@@ -1028,5 +1321,81 @@ mod tests {
         assert!((signed_distance(&torus, p).abs() - torus.distance(p)).abs() < 1e-12);
         let nn = surface_normal(&torus, [1.25, 0.0, 0.0]);
         assert!(norm(sub(nn, [1.0, 0.0, 0.0])) < 1e-12);
+    }
+
+    /// Every model's Jacobian row against central differences of its surface's signed
+    /// distance, at parameters away from the initial estimate and at points around it.
+    #[test]
+    fn analytic_jacobians_match_finite_differences() {
+        fn check<const N: usize, M: Model<N>>(m: &M, x: [f64; N], pts: &[Point3]) {
+            let at = m.at(&x);
+            for &p in pts {
+                let (r, g) = at.row(p);
+                let d0 = signed_distance(&at.surface(), p);
+                assert!((r - d0).abs() < 1e-12, "residual {r} vs {d0}");
+                for j in 0..N {
+                    let h = 1e-6;
+                    let (mut xp, mut xm) = (x, x);
+                    xp[j] += h;
+                    xm[j] -= h;
+                    let fd = (signed_distance(&m.at(&xp).surface(), p)
+                        - signed_distance(&m.at(&xm).surface(), p))
+                        / (2.0 * h);
+                    assert!(
+                        (g[j] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
+                        "parameter {j}: analytic {} vs central difference {fd} at {p:?}",
+                        g[j]
+                    );
+                }
+            }
+        }
+        let mut rng = Pcg64::seed_from_u64(3);
+        let pts: Vec<Point3> = (0..50)
+            .map(|_| {
+                [
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-3.0..3.0),
+                ]
+            })
+            .collect();
+        let dir = normalize([0.3, -0.5, 0.8]).unwrap();
+        check(
+            &SphereModel {
+                center: [0.1, 0.2, -0.3],
+                radius: 1.5,
+            },
+            [0.05, -0.02, 0.1, 0.2],
+            &pts,
+        );
+        check(
+            &CylinderModel {
+                axis_point: [0.1, 0.2, -0.3],
+                axis: Axis::new(dir),
+                radius: 1.2,
+            },
+            [0.05, -0.02, 0.1, -0.15, 0.2],
+            &pts,
+        );
+        check(
+            &ConeModel {
+                axis_point: [0.1, 0.2, -0.3],
+                axis: Axis::new(dir),
+                radius: 1.2,
+                half_angle: 0.5,
+            },
+            [0.05, -0.02, 0.1, -0.15, 0.2, 0.1],
+            &pts,
+        );
+        check(
+            &TorusModel {
+                center: [0.1, 0.2, -0.3],
+                axis: Axis::new(dir),
+                major_radius: 2.0,
+                minor_radius: 0.5,
+            },
+            [0.05, -0.02, 0.1, -0.15, 0.12, 0.2, -0.1],
+            &pts,
+        );
     }
 }
