@@ -68,9 +68,9 @@ pub const MIN_RIGHT_RATIO: f64 = 1.5;
 
 /// Smallest relative difference (high − low) / high of the median curvatures on the two
 /// sides of an accepted threshold: patches of one analytic surface are not split (a
-/// cylinder's curvature varies by round-off only; along a cone whose radius halves the two
-/// halves' medians differ by 0.24 to 0.30, measured on sparse samples). Fillet borders have
-/// far more (plane / fillet 1.0, fillet / spherical corner 0.5).
+/// cylinder's curvature varies by round-off only, and along a cone whose radius halves the two
+/// halves differ by less, see `docs/experiments/fillets.md`). Fillet borders have far more
+/// (plane / fillet 1.0, fillet / spherical corner 0.5).
 pub const MIN_CONTRAST: f64 = 0.35;
 
 /// An accepted threshold's bands must each hold a patch interior of at least this many times
@@ -128,11 +128,9 @@ pub struct FilletParams {
     /// Thresholds per region (section 2.3).
     pub thresholds: ThresholdCount,
     /// With automatic thresholds, a region where none is accepted is examined once more with
-    /// the curvature at 2 × `curvature_k`, for noisy scans (off by default). Measured (100k
-    /// points, noise 10 % of the spacing): the rounded cube's 14 loops (32 of 48 curves) and
-    /// both fillet borders of the fillet-chamfer-cone block, where k alone finds nothing; but
-    /// on the clean block a stretch of the chamfer's 45° edge that the first-order region
-    /// growing went around becomes a curvature band at 2k and gets 26 spurious lines.
+    /// the curvature at 2 × `curvature_k`, for noisy scans (off by default: it finds fillets
+    /// of noisy parts that k alone misses, but on a clean part it turns a 45° chamfer edge into
+    /// a curvature band with spurious lines, see `docs/experiments/fillets.md`).
     pub coarse_retry: bool,
     /// Smooth regions with fewer points are skipped.
     pub min_region_points: usize,
