@@ -22,16 +22,11 @@
 //! names the file, the element and row (and the line for ascii) and what was expected.
 //!
 //! # Why not a crate
-//! `ply-rs-bw` 4.0.1 (the maintained fork of `ply-rs`) was measured on a 1M-point binary little
-//! endian file (float x y z nx ny nz, uchar red green blue, 27 MB) on this 2-core machine: its
-//! generic `DefaultElement` (a hash map per row) took 1.3–4.4 s; a hand-written element that pushes
-//! every value into a `Vec<f64>` per row (what arbitrary named attributes need) took 0.185–0.225 s
-//! before conversion to columns; only a fixed struct for exactly these nine properties was fast
-//! (0.055 s), and that cannot carry the attributes of arbitrary files. It handled hostile counts
-//! well (no allocation from header counts, errors instead of panics), but its binary errors do not
-//! name the row. This reader loads the same file through `crease::io::read` in 0.06–0.10 s
-//! (criterion median 84 ms, `benches/io.rs`, on the shared machine) and a 1M-triangle binary mesh
-//! in 0.04 s; Open3D 0.20 `read_point_cloud` takes 0.116 s (best of 5) on the 1M-point file.
+//! `ply-rs-bw` 4.0.1 (the maintained fork of `ply-rs`) handles hostile counts well, but its
+//! generic element (a hash map per row), or any element that can carry the arbitrary named
+//! attributes of a file, reads a 1M-point scan many times slower than this reader; only a
+//! fixed struct for one set of properties is as fast. Its binary errors do not name the row.
+//! Figures: `docs/experiments/io-readers.md`.
 //!
 //! # Writing
 //! Binary little endian by default, ascii with [`WriteOptions::ascii`] (big endian through
