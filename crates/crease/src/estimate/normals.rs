@@ -446,9 +446,9 @@ pub fn smallest_eigen(a: [f64; 6]) -> (Point3, [f64; 3]) {
 /// same order, so the same bits (tested), but four independent chains. The scalar solve is a
 /// chain of dependent square roots and divisions (about 300 cycles of latency for 150
 /// instructions, the CPU idle most of that time: a large share of the fused kNN + PCA normals
-/// under perf, see `docs/experiments/knn-and-normals.md`); lanes make it throughput-bound. Lanes on a special path of the scalar solve
-/// (a zero or non-finite matrix, a multiple of the identity, λ0 ≈ λ1, where it branches) are
-/// solved by it.
+/// under perf, see `docs/experiments/knn-and-normals.md`); lanes make it throughput-bound.
+/// Lanes on a special path of the scalar solve (a zero or non-finite matrix, a multiple of the
+/// identity, λ0 ≈ λ1, where it branches) are solved by it.
 pub fn smallest_eigen4(a: [[f64; 6]; 4]) -> [(Point3, [f64; 3]); 4] {
     let entry = |t: usize| f64x4::new([a[0][t], a[1][t], a[2][t], a[3][t]]);
     let m: [f64x4; 6] = std::array::from_fn(entry);

@@ -44,13 +44,14 @@
 //! the power-of-two cells of the bounding box's unit (a side anywhere in 0.7 to 1.4 r_k) left
 //! most of them to the shell search; the block search takes fewer instructions per query than
 //! the shell search, and the unranked set ([`knn_map_set`]) fewer than the ranked rows. An
-//! AVX2 build, a comparison sort or a full selection of the candidates, a cache of cell
-//! lookups and other cell sides were slower. Figures (callgrind, perf, timings against PCL
-//! and Open3D): `docs/experiments/knn-and-normals.md`; speed tables: `docs/benchmarks.md`.
+//! AVX2 build, a comparison sort or a full selection of the candidates and other cell sides
+//! were slower, a cache of cell lookups gained nothing. Figures (callgrind, perf, timings
+//! against PCL and Open3D): `docs/experiments/knn-and-normals.md`; speed tables:
+//! `docs/benchmarks.md`.
 //!
-//! **Memory**: the points in Morton order (24 B/point), input indices (4 B/point), the cell table
-//!   (≤ 32 B/point), two (code, index) sorts (16 B/point each, one at a time), plus for [`knn`]
-//!   two n·k u32 buffers (160 MB at 1M, k = 20) and for [`knn_map`] only the n results.
+//! **Memory**: the points in Morton order (24 B/point), input indices (4 B/point), the cell
+//! table (≤ 32 B/point), two (code, index) sorts (16 B/point each, one at a time), plus for
+//! [`knn`] two n·k u32 buffers (160 MB at 1M, k = 20) and for [`knn_map`] only the n results.
 
 use std::sync::OnceLock;
 
