@@ -30,13 +30,10 @@
 //! data: consistent with mizoguchi's 0.9). [`BezierParams::alpha`] implements it for the
 //! biquadratic net: `α² Σ (z_i − patch(u_i, v_i))² + (1 − α)² Σ (b_j0 − 2 b_j1 + b_j2)²` over
 //! all three rows and columns of the 3 × 3 control heights (heights scaled by the region's
-//! extent); the distance weights of that implementation are not used. Measured
-//! (`examples/bezier_alpha.rs`): α = 0.9 lowers the relative RMS error of `κ_max` on the noisy
-//! synthetic sphere (noise 10 % of the edge: 0.099 → 0.061) but raises it without noise
-//! (0.016 → 0.058: the shape term flattens the patch), and the segmentation of the ABC model
-//! falls from 99.77 % to 96.1 % of the area typed right (noisy fillet-chamfer-cone at 10 %:
-//! 83.6 % → 92.9 %; rounded cube: 86.9 % → 85.3 %). Being worse on the real CAD model, it is
-//! off by default (`alpha: None`, the plain least-squares patch).
+//! extent); the distance weights of that implementation are not used. α = 0.9 helps on noisy
+//! synthetic parts but flattens the patch without noise and lowers the segmentation of the
+//! real ABC model (`examples/bezier_alpha.rs`, figures in `docs/experiments/curvature.md`), so
+//! it is off by default (`alpha: None`, the plain least-squares patch).
 //!
 //! **Two passes.** First pass with W = 2: a vertex whose maximum curvature `κ_max` (the principal
 //! curvature of larger absolute value) exceeds `th_se` is a *sharp vertex*. Second pass with
@@ -69,9 +66,8 @@ pub struct BezierParams {
     pub second_width: f64,
     /// `th_se` relative to the mean edge length `l̄`: a vertex is sharp when its first-pass
     /// `|κ_max| > sharp_threshold / l̄`. Default 0.4, i.e. a radius of curvature below 2.5 edge
-    /// lengths. Measured on the synthetic meshes (first pass, W = 2): the vertices on the 90°
-    /// edges of the cube give 1.18–1.22; a sphere of radius 20 l̄ gives 0.05 without noise and
-    /// up to about 0.2 (95th percentile 0.16) with normal noise of 0.1 l̄.
+    /// lengths: well below the cube's 90° edges and above a noisy smooth sphere on the
+    /// synthetic meshes (`docs/experiments/curvature.md`).
     pub sharp_threshold: f64,
     /// An absolute `th_se` (1/length) that overrides `sharp_threshold` when set.
     pub sharp_threshold_absolute: Option<f64>,
@@ -328,9 +324,8 @@ fn vertex_normals(mesh: &TriMesh, topo: &MeshTopology) -> Vec<Point3> {
 #[derive(Default)]
 struct Scratch {
     /// `mark[u] == stamp`: vertex u is in the current region. A stamp per query instead of a
-    /// hash set of the region: the membership test is one load (measured on 1M cloud points,
-    /// the two passes 4.2 -> 3.0 s with identical output; the hash set's probing was a fifth
-    /// of the segmentation's time).
+    /// hash set of the region: the membership test is one load (the hash set's probing was a
+    /// fifth of the segmentation's time, see `docs/experiments/curvature.md`).
     /// Allocated zeroed on first use; only the pages a task's Morton-local queries touch are
     /// ever written.
     mark: Vec<u32>,

@@ -10,17 +10,15 @@
 //! **lower decile** of that value over the cloud.
 //!
 //! Why these choices (measured on the PCEDNet ABC models, 8 clean and 8 noisy, and the synthetic
-//! parts):
+//! parts; figures in `docs/experiments/sharp-noise.md`):
 //! * seven points span about one spacing, where a CAD surface is flat to far below the spacing
 //!   (curvature radii of many spacings), so on a clean cloud the residual comes from the few
 //!   neighbourhoods on edges and on the two faces of thin plates;
-//! * the median is not robust enough: on the clean models made of plates about 1.3–1.8 spacings
-//!   thick (7010, 7034, 7038) the median at 12 neighbours is 0.50–0.60 spacing, as large as on
-//!   the noisy clouds (0.39–0.65), because most neighbourhoods hold points of both faces;
-//! * the lower decile at 6 neighbours is 0.0000 on all 8 clean models (7038 included) and
-//!   0.16–0.22 on all 8 noisy ones (noise σ ≈ 0.5 spacing along the normal): a gap of more than
-//!   two orders of magnitude, so [`NOISY_RATIO`] is set between the noisiest synthetic parts
-//!   the tests use and the least noisy PCEDNet cloud, not tuned on the scores.
+//! * the median is not robust enough: on the clean models made of thin plates it is as large
+//!   as on the noisy clouds, because most neighbourhoods hold points of both faces;
+//! * the lower decile at 6 neighbours separates the clean models from the noisy ones by more
+//!   than two orders of magnitude, so [`NOISY_RATIO`] is set between the noisiest synthetic
+//!   parts the tests use and the least noisy PCEDNet cloud, not tuned on the scores.
 //!
 //! At most [`SAMPLES`] points (every n/SAMPLES-th in input order) are measured, so the cost is
 //! bounded; the result does not depend on the thread count.
@@ -38,11 +36,9 @@ pub const NOISE_K: usize = 6;
 pub const NOISE_QUANTILE: f64 = 0.1;
 /// Most points measured (evenly strided over the input order).
 pub const SAMPLES: usize = 100_000;
-/// The default noise ratio above which a cloud is treated as noisy. Measured: 0.000 on the 8
-/// clean PCEDNet ABC models, 0.16–0.22 on the 8 noisy ones; on the synthetic cube it is about
-/// 0.8 × the Gaussian noise in spacings (0.008 / 0.024 / 0.039 at 1 / 3 / 5 %). 0.08 sits at
-/// half the least noisy PCEDNet cloud and twice the synthetic parts at 5 % noise (the most the
-/// tests and tran section 4.4 use).
+/// The default noise ratio above which a cloud is treated as noisy: 0.08 sits at half the
+/// least noisy PCEDNet cloud and twice the synthetic parts at 5 % noise (the most the tests and
+/// tran section 4.4 use); the ratios measured are in `docs/experiments/sharp-noise.md`.
 pub const NOISY_RATIO: f64 = 0.08;
 
 /// The lower decile over the points of √λ0 / spacing, with λ0 the smallest eigenvalue of the

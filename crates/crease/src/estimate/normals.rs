@@ -17,11 +17,10 @@
 //! * The paper writes σ = k, the neighbour *count*, which is not scale invariant: for a part a
 //!   few units across, exp(−d²/400) ≈ 1 and equation 1 is plain PCA, while in micrometres it
 //!   would zero every weight. The default [`PcaWeight::GaussianRelative`]`(2.0)` uses σ = 2 × the
-//!   root-mean-square of the d_j of the neighbourhood (scale invariant). Measured on synthetic
-//!   spheres, planes and cylinders with noise (tests/normals.rs): σ = 1 × the mean distance
-//!   narrows the effective neighbourhood and raises the median error by ~18 % against plain PCA
-//!   (8.0° vs 6.8° at noise 0.5 spacing) for only ~7 % fewer badly wrong normals next to a
-//!   cube's edges; σ = 2 × the RMS distance costs ≤ 1 %.
+//!   root-mean-square of the d_j of the neighbourhood (scale invariant): on noisy synthetic
+//!   spheres, planes and cylinders (tests/normals.rs) it costs hardly any accuracy against plain
+//!   PCA, where σ = 1 × the mean distance narrows the neighbourhood too much
+//!   (`docs/experiments/knn-and-normals.md`).
 //!   [`PcaWeight::GaussianFixed`]`(k as f64)` reproduces the paper literally and [`PcaWeight::Uniform`] is classical PCA (Hoppe 1992).
 //!
 //! The 3×3 symmetric eigenproblem is solved in closed form (trigonometric eigenvalues of the
@@ -34,11 +33,8 @@
 //! result up to rounding (the same neighbours, summed in another order); each is identical
 //! whatever the thread count.
 //!
-//! Measured on 1M points of a cube's faces at k = 20 (release, 2 threads, best of 3 in one
-//! process, side by side with PCL and Open3D by `scripts/compare-normals.sh`):
-//! `pca_normals_direct` 0.468 s on a Morton-sorted file (PCL `NormalEstimationOMP` 1.745 s,
-//! Open3D 2.28 s: 3.7x) and 0.662 s in random order (PCL 3.74 s, Open3D 10.2 s: 5.7x), 2026-12-02;
-//! another run that day 0.556 s sorted (PCL 1.78 s, 3.2x), 0.609 s random (PCL 3.99 s, 6.6x).
+//! Timed against PCL and Open3D by `scripts/compare-normals.sh` (figures in
+//! `docs/benchmarks.md` and `docs/experiments/knn-and-normals.md`).
 //! The covariances are computed in the query loop and parked in the output slots, then solved
 //! four at a time ([`smallest_eigen4`]): the scalar solve is a latency-bound chain of square
 //! roots and divisions.
@@ -233,10 +229,8 @@ pub fn estimate_normals(points: &[Point3], k: usize) -> Result<Vec<Point3>> {
 /// Two passes: the centroid and the mean squared distance to it from sums taken relative to `p`
 /// (small numbers, no cancellation to speak of), then the weights and the covariance. Both
 /// passes run four points at a time (SIMD lanes over p and its neighbours, the last group
-/// padded with zero-weight lanes). Measured (callgrind, k = 20): about as many instructions
-/// as the scalar loop, but short dependency chains; best-of-five wall time of the fused kNN +
-/// PCA on 1M sorted cube points 0.82 → 0.72 s (the machine varies by ±20 %, see
-/// [`crate::spatial::knn`]).
+/// padded with zero-weight lanes): about as many instructions as the scalar loop, but short
+/// dependency chains, hence faster (`docs/experiments/knn-and-normals.md`).
 #[inline]
 pub(crate) fn weighted_pca(p: Point3, nbrs: &[Point3], weight: PcaWeight) -> (Point3, [f64; 3]) {
     smallest_eigen(weighted_covariance(p, nbrs, weight))
@@ -451,10 +445,10 @@ pub fn smallest_eigen(a: [f64; 6]) -> (Point3, [f64; 3]) {
 /// [`smallest_eigen`] of four matrices at once, one per SIMD lane: the same operations in the
 /// same order, so the same bits (tested), but four independent chains. The scalar solve is a
 /// chain of dependent square roots and divisions (about 300 cycles of latency for 150
-/// instructions: 13 % of the fused kNN + PCA normals' samples under perf, the CPU idle most of
-/// that time); lanes make it throughput-bound. Lanes on a special path of the scalar solve
-/// (a zero or non-finite matrix, a multiple of the identity, λ0 ≈ λ1, where it branches) are
-/// solved by it.
+/// instructions, the CPU idle most of that time: a large share of the fused kNN + PCA normals
+/// under perf, see `docs/experiments/knn-and-normals.md`); lanes make it throughput-bound.
+/// Lanes on a special path of the scalar solve (a zero or non-finite matrix, a multiple of the
+/// identity, λ0 ≈ λ1, where it branches) are solved by it.
 pub fn smallest_eigen4(a: [[f64; 6]; 4]) -> [(Point3, [f64; 3]); 4] {
     let entry = |t: usize| f64x4::new([a[0][t], a[1][t], a[2][t], a[3][t]]);
     let m: [f64x4; 6] = std::array::from_fn(entry);
@@ -560,8 +554,9 @@ const ROOT_MIN_W: f64 = 0.02;
 /// C = (A − qI)/p of [`smallest_eigen`], whose characteristic polynomial this is (trace 0,
 /// tr C² = 6, det C = 2r), in [−2, −1].
 ///
-/// Smith's formula gives it as 2 cos((acos r + 2π)/3); the acos and the cos cost 5 % of the
-/// fused kNN + PCA normals (perf, 1M points). Instead: as a function of w = √((1 − r)/2) the
+/// Smith's formula gives it as 2 cos((acos r + 2π)/3); the acos and the cos were a visible
+/// share of the fused kNN + PCA normals under perf (`docs/experiments/knn-and-normals.md`).
+/// Instead: as a function of w = √((1 − r)/2) the
 /// root is smooth on [0, 1] (the square-root branch point at the double root r = 1 becomes
 /// linear), and a degree-4 polynomial (Chebyshev fit) is within 4e-5 of it; three Newton steps
 /// then reach rounding (the error squares at each step, times f''/2f' ≤ 1.2 for w ≥ 0.25 and

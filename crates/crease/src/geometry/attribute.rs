@@ -162,7 +162,8 @@ impl Attributes {
 
     /// Adds many attributes at once, each replacing an attribute of the same name (a later one
     /// of `attrs` wins over an earlier one): linear in their number, where one [`insert`] after
-    /// another is quadratic (a text file of 100,000 columns took 81 s to read).
+    /// another is quadratic (a wide text file took over a minute to read, see
+    /// `docs/experiments/io-readers.md`).
     ///
     /// [`insert`]: Attributes::insert
     pub fn extend(&mut self, len: usize, attrs: Vec<Attribute>) -> Result<()> {

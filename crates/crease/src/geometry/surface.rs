@@ -274,9 +274,10 @@ fn cone_normal(p: Point3, apex: Point3, axis_dir: Point3, (s, c): (f64, f64)) ->
 
 /// A surface with its per-surface constants computed once (the cone's sine and cosine of its
 /// half angle), for loops over many points: [`Prepared::signed_distance`] equals
-/// [`signed_distance`] and [`Prepared::normal`] [`surface_normal`] bit for bit. Measured on a 9.7k-point scan (`scans/curvsurf`), the
-/// per-point `sin_cos` of the cone's distance was half the segmentation's time, in the
-/// Levenberg–Marquardt refinements, which then evaluated every residual 2N + 1 times an iteration.
+/// [`signed_distance`] and [`Prepared::normal`] [`surface_normal`] bit for bit. The per-point
+/// `sin_cos` of the cone's distance was half the segmentation's time on a scan, in the
+/// Levenberg–Marquardt refinements, which then evaluated every residual 2N + 1 times an
+/// iteration (`docs/experiments/segmentation.md`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Prepared {
     surface: SurfaceParams,

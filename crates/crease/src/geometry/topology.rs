@@ -157,8 +157,8 @@ impl MeshTopology {
     /// too large for 32-bit incidence lists (`3F + V >= 2^31`).
     ///
     /// Cost: O(V + F) plus per-vertex sorts of the few half-edges and faces around each vertex,
-    /// mostly in parallel; measured at about 0.6 s of CPU time for a million triangles whose
-    /// vertex ids are randomly ordered (the worst case for memory access).
+    /// mostly in parallel; randomly ordered vertex ids are the worst case for memory access
+    /// (timed in `docs/experiments/mesh-topology.md`).
     pub fn new(mesh: &TriMesh) -> Result<MeshTopology> {
         mesh.check_indices()?;
         let nv = mesh.num_vertices();

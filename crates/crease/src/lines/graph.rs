@@ -479,11 +479,10 @@ fn along_line(clusters: &Clusters, g: &ClusterGraph, p: u32, q: u32) -> bool {
 /// the other. Taken literally, N is mostly made of p's own branch (every vertex within n steps
 /// behind it, all refused by the path test), so a gap longer than about n/2 spacings is never
 /// bridged, while vertices beside the branch (a parallel line, the far side of a corner) are
-/// accepted. Measured on the synthetic parts (`examples/lines_synth.rs`): the noiseless cube
-/// lost an edge whose gap to its corner was 6 spacings, the chamfer lines of the
-/// fillet-chamfer-cone part (fragmented by the spanning tree) were cut across, and spurious
-/// links gave extra junctions on the two-cylinder part. crease keeps the two cases and the
-/// path test of the paper and changes how N is formed and the order of the links:
+/// accepted: on the synthetic parts (`examples/lines_synth.rs`) that lost edges, cut chamfer
+/// lines across and added spurious junctions (`docs/experiments/sharp-lines.md`). crease keeps
+/// the two cases and the path test of the paper and changes how N is formed and the order of
+/// the links:
 /// - N holds the `n` nearest vertices that may be linked: no path of at most `d` edges to p,
 ///   within `2 n h` of p (h: the median edge length of the graph; the paper's n nearest span
 ///   about n h along a line, the bound doubles it), and ahead of the branch: within 60° of its
@@ -498,10 +497,8 @@ fn along_line(clusters: &Clusters, g: &ClusterGraph, p: u32, q: u32) -> bool {
 ///   spur beside its own feature) or closes a cycle of at most `2 d` edges (the two ends of a
 ///   gap linking past each other to the opposite sides).
 ///
-/// On the synthetic parts at 1 to 10 % noise this gives exactly the parts' curve networks
-/// (cube: 12 polylines and 8 junctions; two cylinders: 6 closed loops; box with hole and the
-/// fillet-chamfer-cone part: 14 polylines, 2 loops, 8 junctions), where the literal reading
-/// gave 9 to 20 polylines.
+/// On the synthetic parts at 1 to 10 % noise this gives exactly the parts' curve networks,
+/// where the literal reading did not.
 pub fn close(clusters: &Clusters, g: &mut ClusterGraph, n: usize, d: usize) -> CloseReport {
     let mut report = CloseReport::default();
     let active: Vec<u32> = (0..g.num_vertices() as u32)

@@ -11,9 +11,9 @@
 //! 4. G_pruned_mst: minimum spanning forest with large-cluster edges weighted last, then those
 //!    edges removed ([`graph::pruned_mst`], section 2.5); also removed: edges at small clusters
 //!    that reach fewer than two large clusters within 3 steps of G_all
-//!    ([`graph::between_patches`]). This is crease's addition for noise: at 10 % noise (of
-//!    the spacing) the flat faces of a cube are sprinkled with small clusters whose tree
-//!    wires spurious lines across the faces (37 polylines instead of 12); with it, 12;
+//!    ([`graph::between_patches`]). This is crease's addition for noise: on noisy clouds the
+//!    flat faces are sprinkled with small clusters whose tree wires spurious lines across the
+//!    faces (figures: `docs/experiments/sharp-lines.md`);
 //! 5. G_pruned_branches: Algorithm 2 with d_max = 5 ([`graph::prune_branches`], section 2.6);
 //! 6. G_closed: the connect algorithm for every endpoint, then pruning of what still ends
 //!    ([`graph::close`], section 2.7).
@@ -235,19 +235,16 @@ fn check_params(params: &LinesParams) -> Result<()> {
 ///
 /// **Noisy clouds (an addition to the paper).** A 1-ring holds about six points, so its
 /// least-squares normal follows the noise: with Gaussian noise of 20 % of the spacing along the
-/// normal, adjacent 1-ring normals on a flat face differ by 11° at the median (measured on the
-/// synthetic parts: 0° without noise, 2.7° at 5 %, 5.5° at 10 %, 17° at 30 %), more than
-/// α_max = 8°, and the region growing shatters the faces into thousands of small clusters
-/// (at 20 %: 160 to 290 polylines instead of 6 to 14). With `params.denoise_normals`, when the
+/// normal, adjacent 1-ring normals on a flat face differ by more than α_max = 8° at the median,
+/// and the region growing shatters the faces into thousands of small clusters and hundreds of
+/// polylines. With `params.denoise_normals`, when the
 /// median adjacent angle exceeds 0.75 α_max, the normals are smoothed by bilateral passes
 /// ([`segment::smooth_normals`], σ = 1.5 × the current median angle) until that median is at
 /// most α_max / 4 (at most 6 passes). Normals across a 90° edge differ by about 45° per step
 /// and keep a weight below exp(−4), so the edges stay; shallow creases are blurred, which is
 /// why clouds quiet enough for the plain region growing (10 % noise and less) are left as they
-/// are. Measured with `examples/lines_synth.rs` at 20 %: the cube and the box with a hole give
-/// their exact networks, the two cylinders 6 loops plus one spurious link, the
-/// fillet-chamfer-cone part every curve at 91 % or more with 4 extra polylines. σ = 2 smooths
-/// the cube and the box exactly even at 30 % but erases the 45° chamfer lines at 20 %.
+/// are. σ = 1.5 × the median keeps the 45° chamfer lines, which σ = 2 erases at 20 % noise
+/// (`examples/lines_synth.rs`, figures in `docs/experiments/sharp-lines.md`).
 pub fn first_order(points: &[Point3], params: &LinesParams) -> Result<FirstOrder> {
     check_params(params)?;
     let t = Instant::now();

@@ -2,20 +2,18 @@
 //! (Y. Zheng, H. Fu, O. K.-C. Au, C.-L. Tai, "Bilateral normal filtering for mesh denoising",
 //! IEEE TVCG 17(10), 2011, equation 4), one of the two sources of the `filtered` and
 //! `potts-filtered` methods' angle ([`super::filtered_dihedral`]; the other is
-//! [`super::tv`]). The figures below are of the bilateral angle alone.
+//! [`super::tv`]).
 //!
 //! **Why (crease's addition to vidal et al. 2011).** At the noise of section 6.1 (Gaussian,
 //! 0.5 % of the bounding box's largest side: 0.3 to 0.5 edge lengths on our meshes) adjacent
-//! face normals differ by a median 29° (fandisk) to 55° (bar), more than many crease angles,
-//! so the dihedral angle and the tangent-plane estimator of section 3 lose the position of the
-//! line: the learned classifier's AUC lost 3 to 5 points to the edges one or two rings beside
-//! the true lines (measured on the six classic meshes). A few iterations of bilateral
-//! filtering pull each face normal towards the normals of the neighbouring faces that are
-//! already similar to it, so the faces on either side of a crease keep their own plane's
-//! normal and the crease stays at the mesh edge between them. The dihedral angle of the
-//! filtered normals alone scores a mean AUC of 95.8 % on the six noisy classic meshes (the
-//! raw dihedral angle 81.0 %, the paper's learned classifier 93.4 %; measured with 3
-//! iterations).
+//! face normals differ by more than many crease angles, so the dihedral angle and the
+//! tangent-plane estimator of section 3 lose the position of the line, and the learned
+//! classifier loses AUC to the edges one or two rings beside the true lines. A few iterations
+//! of bilateral filtering pull each face normal towards the normals of the neighbouring faces
+//! that are already similar to it, so the faces on either side of a crease keep their own
+//! plane's normal and the crease stays at the mesh edge between them: the dihedral angle of
+//! the filtered normals alone ranks edges better than the raw angle and the paper's learned
+//! classifier (figures: `docs/experiments/mesh-edges-filtered-angle.md`).
 //!
 //! One iteration (Jacobi: every face reads the previous iteration's normals):
 //!
@@ -26,26 +24,20 @@
 //!
 //! **Choices made here (the paper leaves σ_s and σ_r to the user).**
 //! - σ_s is the mean length of face i's edges, so that the spatial kernel follows the local
-//!   resolution of unevenly tessellated CAD meshes (a global mean edge length scored 93.6 %
-//!   instead of 94.3 % mean AUC at 5 iterations).
+//!   resolution of unevenly tessellated CAD meshes (a global mean edge length scored lower).
 //! - σ_r = [`BilateralParams::range_factor`] (2.5) × the median chord ‖n_i − n_j‖ = 2 sin(θ/2)
 //!   of the dihedral angles θ over the edges with two faces, never below the chord of
 //!   [`BilateralParams::min_range_degrees`] (10°): it follows the measured noise as the
 //!   tangent-plane estimator's acceptance angle does ([`super::tangent::accept_angle`]), and a
 //!   clean mesh (median near 0) is filtered with a narrow range kernel that keeps its creases.
-//!   With the score of [`super::filtered_dihedral`] (the mean over iterations 1 to 3), mean
-//!   AUC over the 11 meshes of `examples/meshfeat_table2.rs`, factor 1.5 / 2 / 2.5 / 3: 96.0
-//!   / 97.3 / 97.4 / 97.3 % at the 0.5 % noise of our protocol; 2.5 also at 0.1, 0.2 and
-//!   0.3 % noise 99.2, 99.0 and 98.7 %. A floor of 50° instead of 10° scored the same or
-//!   more on the mean, but only through block.off's sliver faces (see [`super::truth`]):
-//!   without block 97.73 / 99.56 % against 97.73 / 99.63 % at 0.5 / 0.2 % noise, so the
-//!   kernel that keeps creases stays.
+//!   2.5 scored best among the factors 1.5 to 3; a higher floor gained only through block.off's
+//!   sliver faces (see [`super::truth`]), so the floor that keeps creases stays.
 //! - Vertices are not moved (the paper's second stage): only the normals are needed. Zheng's
-//!   vertex update (rounds of filtering and moving the vertices onto the filtered planes) was
-//!   measured and scored lower: 88–89 % mean AUC at 0.5 % noise with the normals of the moved
-//!   vertices, 94–97 % with the last filtered normals. Guided normal filtering (Zhang et al.
-//!   2015: the range kernel reads the mean normal of the most consistent 1-ring patch) scored
-//!   92.6–94.0 %: at this noise no 1-ring patch is consistent enough to guide.
+//!   vertex update (rounds of filtering and moving the vertices onto the filtered planes) and
+//!   guided normal filtering (Zhang et al. 2015) scored lower: at this noise no 1-ring patch is
+//!   consistent enough to guide.
+//!
+//! The figures of each choice: `docs/experiments/mesh-edges-filtered-angle.md`.
 //!
 //! Parallel over the faces; each value depends only on the mesh, never on the thread count.
 

@@ -31,9 +31,9 @@
 //!   smallest magnitude belongs to the normal; the other two are K_min ≤ K_max. Curvatures are
 //!   multiplied by the ball's radius r (K by r²): dimensionless (the angle the normal turns
 //!   over the ball), so they do not depend on the mesh's units, and at the scales clamped to 2
-//!   edge lengths they do not grow with the resolution either (measured: with curvatures in
-//!   units of the reference length instead, the default model found no feature edge at d > 0
-//!   on a noisy 1M-edge part, 10 times finer than its training meshes).
+//!   edge lengths they do not grow with the resolution either (in units of the reference
+//!   length instead, the default model found no feature edge on a mesh much finer than its
+//!   training meshes, see `docs/experiments/mesh-edges-tangent.md`).
 //! - The "similarity measure" of Lee et al. 2005 (mesh saliency) at scale r: |G(H, σ) −
 //!   G(H, 2σ)| with σ = r / 4, G(H, σ) the Gaussian-weighted (standard deviation σ) mean of the
 //!   vertices' mean curvature H within 2σ, H taken at the smallest curvature scale.
@@ -70,10 +70,8 @@ pub const CURVATURE_OFFSET: usize = 13;
 #[derive(Debug, Clone, PartialEq)]
 pub struct FeatureParams {
     /// The tangent-plane estimator; its scales are the 9 of section 4 (default), its budget
-    /// `max_faces` bounds the cost (default 24: on a 1M-edge mesh the 9 scales at 128 faces
-    /// cost 50 s alone; measured with `examples/meshfeat_learned.rs`, models trained with
-    /// budgets 48 / 128 and 24 / 64 (tangent / curvature) give the same Table 2 AUCs, noisy
-    /// mean 91.6 % and 91.7 %).
+    /// `max_faces` bounds the cost (default 24: models trained with larger budgets give the
+    /// same Table 2 AUCs at a far higher cost, see `docs/experiments/mesh-edges-tangent.md`).
     pub tangent: TangentParams,
     /// The five curvature scales (fractions of the reference length).
     pub curvature_scales: Vec<f64>,

@@ -13,18 +13,10 @@
 //! no straight continuation of high score and loses, a crease edge of low noisy angle borrows
 //! from its neighbours on the crease.
 //!
-//! **Measured** (mean AUC over the 11 meshes of `examples/meshfeat_table2.rs`, clean / 0.2 % /
-//! 0.5 % noise of the largest side; `filtered` / `fused` with the SVM weight 0.1):
-//! - without the smoothing: 100.00 / 99.15 / 98.63 % and 100.00 / 99.59 / 98.81 %;
-//! - steps 2, β = 0.2, 45°: **100.00 / 99.62 / 98.80 %** and **100.00 / 99.72 / 98.86 %**;
-//! - β = 0.3: 100.00 / 99.64 / 98.80 % and 99.99 / 99.71 / 98.84 %; β = 0.5: `filtered` 99.98 /
-//!   99.61 / 98.71 %; 1 step, β = 0.3: 100.00 / 99.56 / 98.78 %; 3 steps, β = 0.5: 99.98 /
-//!   99.59 / 98.64 %;
-//! - a largest turn of 60° or 32° instead of 45°: `fused` 98.83 and 98.86 % at 0.5 %.
-//!
-//! An earlier attempt that rescored an edge by the best-scoring continuation at each endpoint
-//! (choosing by the score, not by the geometry) lowered the mean AUC (96.2–96.4 % against
-//! 97.42 % for the bilateral angle of the time): it rewarded the edges beside a crease too.
+//! The defaults (2 steps, β = 0.2, at most 45° of turn) scored best among the settings
+//! measured with `examples/meshfeat_table2.rs`; choosing the continuation by the score
+//! instead of the geometry scored lower, as it rewards the edges beside a crease too
+//! (`docs/experiments/mesh-edges-filtered-angle.md`).
 //!
 //! Parallel over the edges; each value depends only on the mesh and the scores.
 

@@ -25,13 +25,9 @@
 //! * [`bilateral`] and [`tv`] (crease's additions, not in the paper): bilateral and
 //!   total-variation filtering of the face normals; `filtered` thresholds the mean of the two
 //!   dihedral angles of the filtered normals ([`filtered_dihedral`]), `potts-filtered` feeds it
-//!   to equation 1 with the data term of equation 5 (mean AUC on the 11 meshes of Table 2:
-//!   98.80 % at the 0.5 % noise of our protocol, the SVM 95.1 %; 99.62 % at 0.2 %, the noise at
-//!   which our dihedral thresholding scores what the paper reports for it, 97.2 % against
-//!   97.3 %). The bilateral filtered dihedral
-//!   angle as three more SVM features was measured too and did not help the learned
-//!   classifier (noisy mean 95.02 % shipped, 94.94 % leave-one-out), nor did the point-cloud
-//!   sharp stage's sharpness at the vertices (94.69 % / 95.53 %);
+//!   to equation 1 with the data term of equation 5. On noisy meshes it ranks edges far better
+//!   than the SVM; given to the SVM as more features, it did not help the learned classifier
+//!   (figures: `docs/experiments/mesh-edges-fused.md`);
 //! * `fused` (the default, crease's addition): the SVM decision value and the filtered angle
 //!   combined ([`fused_scores`]), better than either on every noise level measured, plus the
 //!   evidence of [`surfaces`]: where the analytic surfaces fitted by the segmentation
@@ -364,12 +360,9 @@ impl EdgeMethod {
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeParams {
     /// The method (default `fused`: the most accurate crease has on the 11 meshes of Table 2,
-    /// mean AUC 100.00 % clean, 99.74 % at noise 0.2 % of the largest side and 99.04 % at
-    /// 0.5 %, against 100.00 / 99.62 / 98.80 % for `filtered`, 98.61 / 98.20 / 95.07 % for
-    /// `learned` with the shipped model, 98.23 / 97.43 / 93.48 % for the tangent-plane angle and
-    /// 100 / 97.18 / 80.43 % for dihedral thresholding; measured with
-    /// `examples/meshfeat_table2.rs` and `examples/meshfeat_learned.rs`). `filtered` is 20
-    /// times faster (1.4 s against 24–27 s at 1M edges) and nearly as accurate.
+    /// clean and noisy, measured with `examples/meshfeat_table2.rs` and
+    /// `examples/meshfeat_learned.rs`; figures in `docs/experiments/mesh-edges-fused.md`).
+    /// `filtered` is about 20 times faster and nearly as accurate.
     pub method: EdgeMethod,
     /// Threshold of `dihedral` / `tangent` and high threshold of `hysteresis`, degrees
     /// (default 65: where θ̂ʳ gives the best F1 on the noisy synthetic parts; on clean meshes
@@ -411,11 +404,9 @@ pub struct EdgeParams {
 pub const FUSED_SVM_WEIGHT: f64 = 0.1;
 
 /// Default iterations of bilateral normal filtering ([`filtered_dihedral`] averages the
-/// dihedral angle over iterations 1 to this): mean AUC of the bilateral angle alone over the
-/// 11 meshes of
-/// `examples/meshfeat_table2.rs` at 0.5 % noise 97.00 / 97.42 / 97.48 / 97.28 % for 2 / 3 / 4 /
-/// 6 iterations, at 0.2 % noise 98.85 / 98.96 / 98.88 % for 1 / 3 / 5 (the earlier score, the
-/// last iteration alone, peaked at 3 too).
+/// dihedral angle over iterations 1 to this): 3 is at or near the best mean AUC of the
+/// bilateral angle at both noise levels measured (`examples/meshfeat_table2.rs`,
+/// `docs/experiments/mesh-edges-filtered-angle.md`).
 pub const FILTER_ITERATIONS: usize = 3;
 
 /// See [`filtered_dihedral`]: the angle between two normals with independent noise has a
@@ -435,11 +426,9 @@ pub const LEARNED_POTTS: PottsParams = PottsParams {
 };
 
 /// Default scales of the `tangent` and `potts-tangent` methods (fractions of the reference
-/// length): the three smallest of section 4. Measured with `examples/meshfeat_table2.rs` on
-/// the 14 noisy meshes: mean AUC 89.2 % (r = 4, 7, 10 %) against 89.3 % for r = 7, 10, 13 %
-/// at 2.3 times the cost and 84.0 % for r = 4 % alone (dihedral thresholding: 78.8 %;
-/// measured before the 2-edge smallest radius, with which the default gives 87.5 %, and 90.1 %
-/// with the noise-adapted acceptance angle).
+/// length): the three smallest of section 4, as accurate on the noisy meshes of
+/// `examples/meshfeat_table2.rs` as the next three at less than half the cost, and better than
+/// the smallest alone (`docs/experiments/mesh-edges-tangent.md`).
 pub const DEFAULT_TANGENT_SCALES: [f64; 3] = [0.04, 0.07, 0.10];
 
 impl Default for EdgeParams {
@@ -599,61 +588,21 @@ pub fn detect_prepared(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetecti
 /// neighbours on block.off) to one of its neighbours and so loses one of its two feature
 /// edges; on clean meshes (median near 0) the raw angle keeps them.
 ///
-/// **The mean over the iterations** (crease's choice, measured): one iteration keeps small
-/// features and the exact position of a crease, later ones remove more noise; their mean is a
-/// multi-scale score, as the paper's multi-scale tangent-plane features (section 4) are. With
-/// the default range factor 2.5 and 3 iterations, mean AUC over the 11 meshes of
-/// `examples/meshfeat_table2.rs` with noise of 0.2 % of the largest side (the level at which
-/// our dihedral thresholding scores what the paper's Table 2 reports for it, see the README):
-/// 98.14 % → 98.96 % (cup 97.30 → 99.27, ABC 97.70 → 99.49, bar 98.23 → 99.77, no mesh
-/// worse); at the 0.5 % noise of our own protocol 96.69 % → 97.42 % (block 86.8 → 94.2,
-/// sharp_sphere 94.8 → 97.0 and cup 94.6 → 96.3 gain; fandisk 97.7 → 96.9 and ABC 95.4 →
-/// 93.7 lose), measured against the last iteration alone with range factor 1.5, the earlier
-/// default. Clean meshes: 99.99 % → 100.00 %.
+/// **The mean over the iterations** (crease's choice): one iteration keeps small features and
+/// the exact position of a crease, later ones remove more noise; their mean is a multi-scale
+/// score, as the paper's multi-scale tangent-plane features (section 4) are. With the range
+/// factor 2.5 it ranks edges better at 0.2 % and 0.5 % noise than the last iteration alone did
+/// with the earlier factor 1.5.
 ///
-/// **The line smoothing** (added 2026-12-03, see [`mod@line`]): 99.15 → 99.62 % at 0.2 %, 98.63 →
-/// 98.80 % at 0.5 %, clean 100.00 %.
+/// **The total-variation half** and **the line smoothing** ([`tv`], [`mod@line`]) each raise
+/// the mean AUC at both noise levels. The two filters fail apart: total variation keeps a
+/// crease one edge wide on fine meshes, bilateral filtering does not invent creases on coarse
+/// curved tessellations; their mean scored above their geometric mean and their minimum.
 ///
-/// **The total-variation half** (added 2026-12-03, measured with `examples/meshfeat_table2.rs`,
-/// bilateral alone → averaged): 100.00 → 100.00 % clean, 98.96 → 99.15 % at 0.2 %, 97.42 →
-/// 98.63 % at 0.5 %. The two filters fail apart: total variation keeps a crease one edge wide
-/// on fine meshes (ABC 93.7 → 99.1 %, fandisk 96.9 → 98.8 %), bilateral filtering does not
-/// invent creases on coarse curved tessellations (cup, block, sharp_sphere; see [`tv`]). Their
-/// mean scored above their geometric mean (98.30 %) and their minimum (97.43 %).
-///
-/// **Measured and rejected on 2026-12-04** (`fused` mean AUC over the 11 meshes at 0.5 %
-/// noise, 98.86 % with this function; the noise draw reported everywhere is seed 7, and seeds
-/// 1, 2, 3 score 98.91, 98.88 and 98.96 %, so the expected value is about 98.90 %):
-/// - non-maximum suppression across the line, θ − α max(0, θ_max − θ) with θ_max over the
-///   other edges of the two faces: α = 0.1 / 0.2 / 0.4 scored 98.62 / 98.16 / 97.16 % (the
-///   two creases of a strip one face wide suppress each other: block 96.6 → 95.2 %);
-/// - power means of the two angles instead of their mean (p = 0.5, 2, 4): 98.85, 98.83, 98.79 %;
-/// - the total-variation weight chosen per mesh from its median raw dihedral angle (the noise
-///   level), clamp((m − 5°) / 40°, 0.2, 0.9): 98.95 %, close to the 98.96 % of the best weight
-///   per mesh; not adopted, a rule fitted to these 11 meshes that drops the total variation at
-///   lower noise, where it helps;
-/// - the total-variation jumps guided by a first pass (edge weight 1 − γ min(θ / θ_ref, 1)):
-///   98.80–98.87 %;
-/// - the tangent-plane angle of section 3 on the filtered normals, at 2 or 3 mean edge
-///   lengths, as a third third of the mean: 97.80–98.35 % (its region averaging spreads the
-///   crease again);
-/// - a bilateral range kernel capped at the chord of 45°–90°: 96.79–98.79 % (at high noise
-///   the wide kernel is what works), or wider (factor 3.5, or no range kernel): 98.78 /
-///   98.70 %;
-/// - the line smoothing with the chain's median, or with the larger of its two directional
-///   means (so that a line's end keeps its score): 98.81–98.86 %;
-/// - the SVM trusted more on the edges of thin faces (aspect below 0.05–0.2): 98.25–98.83 %;
-/// - the SVM retrained on the 43 features of the total-variation normals instead of the raw
-///   ones: 94.97 % alone (the shipped one 95.07 %), 98.87 % fused;
-/// - a second-stage RBF SVM on 13 to 16 per-edge measures (the raw, bilateral, total-variation,
-///   mixed and smoothed angles, the chain mean, the largest and mean angle of the neighbouring
-///   edges, face aspect, edge length, the noise level, the SVM decision), trained leave-one-out
-///   on the other 10 meshes (clean and 0.2 / 0.35 / 0.5 % noise, the hardest 20 % of their
-///   edges) and added to `fused` with weight 0.3: 98.93–98.96 %, for a model trained on the
-///   classic meshes and a slower pipeline;
-/// - equation 1 on the fused score (the SVM data term of equation 2, μ 0.1–3): pooled F1 at
-///   0.5 % 0.36–0.78 against 0.780 for thresholding at 0 (which is also the F1-optimal
-///   threshold at every noise level: 0.983 / 0.889 / 0.780 clean / 0.2 % / 0.5 %).
+/// The figures of each step, and the variants measured and rejected (non-maximum suppression
+/// across the line, other means of the two angles, a per-mesh total-variation weight, the
+/// tangent-plane angle of the filtered normals, other range kernels, a second-stage SVM,
+/// equation 1 on the fused score): `docs/experiments/mesh-edges-filtered-angle.md`.
 pub fn filtered_dihedral(
     em: &EdgeMesh,
     iterations: usize,
@@ -799,34 +748,15 @@ fn detect_learned(em: &EdgeMesh, params: &EdgeParams) -> Result<EdgeDetection> {
 /// [`surfaces::intersection_scores`] (`intersection`; `None` = 0) and β its weight
 /// ([`IntersectionParams::weight`], default 0.3), all from `params`.
 ///
-/// **The intersection term** (added 2026-12-04, see [`surfaces`] for its measurements): mean
-/// AUC over the 11 meshes 100.00 / 99.71 / 98.86 % → 100.00 / 99.74 / 99.04 % (clean / 0.2 % /
-/// 0.5 %), 99.56 → 99.63 % at 0.289 %; the table below was measured without it.
-///
 /// **Why.** The two estimators fail on different meshes. The SVM, trained on synthetic parts
 /// only, reads the 43 multi-scale features of section 4 and handles coarse CAD tessellations
 /// with slivers and curved faces (noisy block.off, cup, sharp_sphere); the filtered angle
 /// localises creases on fine meshes (fandisk, bar, the ABC model), where the SVM's wide
-/// scales blur them. Mean AUC over the 11 meshes of Table 2 (`examples/meshfeat_learned.rs`,
-/// shipped model), clean / noise 0.2 % / 0.5 % of the largest side:
-///
-/// | w | clean | 0.2 % | 0.5 % |
-/// |---|---|---|---|
-/// | 0 (`filtered`) | 100.00 | 99.62 | 98.80 |
-/// | **0.1** | **100.00** | **99.71** | **98.86** |
-/// | 0.15 | 99.99 | 99.72 | 98.80 |
-/// | 1 (`learned`) | 98.61 | 98.20 | 95.07 |
-///
-/// Measured with the filtered angle of 2026-12-03 (bilateral and total variation, smoothed
-/// along the lines). With the sliver edges not scored (`meshfeat::sliver_edges`), w = 0.1
-/// scores 99.91 % at 0.2 % and 99.19 % at 0.5 %. With the two filters but without the line
-/// smoothing, w = 0.1 / 0.15 / 0.2 scored 99.59 / 99.65 / 99.67 % at 0.2 % and 98.81 / 98.78
-/// / 98.70 % at 0.5 %; with the bilateral angle alone, w = 0 / 0.1 / 0.2 / 0.3 / 0.5 scored
-/// 98.96 / 99.50 / 99.59 / 99.56 / 99.42 % and 97.42 / 97.82 / 97.78 / 97.58 / 96.96 %.
-///
-/// A rank average of the two scores scored lower (0.5: 99.79 / 99.28 / 97.39), and so did
-/// the filtered angles as three more SVM features (leave-one-out 99.15 % at 0.2 %, the SVM
-/// alone 99.12 %): the RBF kernel dilutes one strong feature among 43.
+/// scales blur them. w = 0.1 gave the best mean AUC over the 11 meshes of Table 2 at 0.5 %
+/// noise and within 0.01 point of the best at 0.2 % (`examples/meshfeat_learned.rs`); a rank
+/// average of the two scores, and the filtered angles as more SVM features, scored lower (the
+/// RBF kernel dilutes one strong feature among 43). The intersection term ([`surfaces`])
+/// raises the noisy AUCs further. Figures: `docs/experiments/mesh-edges-fused.md`.
 pub fn fused_scores(
     decision: &[f64],
     filtered: &[f64],

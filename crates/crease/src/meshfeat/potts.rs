@@ -23,25 +23,15 @@
 //! (`potts-dihedral`) or crease's choice, the tangent-plane angle θ̂ʳ (`potts-tangent`); the
 //! similarity term of eq. 4 always uses the same angle as the data term.
 //!
-//! **Parameters and what they measured.** With the paper's μ = 2 the pairwise reward of two
-//! aligned feature edges (−2 α) outweighs the data cost of labelling noisy flat edges as
-//! features, and on crease's meshes every edge ends up a feature (false-positive rate 1 on
-//! all 14 meshes of `examples/meshfeat_table2.rs`). The default μ = 0.05 keeps the labelling
-//! close to thresholding the data angle at θ_true: on the 14 noisy meshes the AUC of
-//! `potts-tangent` swept over 200 θ_true (as section 6.3) is 87.46 % against 87.45 % for
-//! thresholding θ̂ʳ (`potts-dihedral` 78.70 %, dihedral thresholding 78.80 %), and its F1 at
-//! θ_true = 65° equals thresholding's (pooled 0.31); μ = 0.3 and 1 lower the F1 (measured
-//! before the 2-edge smallest radius: 0.30 and 0.26 against 0.31). So in
-//! crease's measurements the global energy does not beat plain thresholding of its own data
-//! term. The same holds for the SVM data term of equation 2 with the paper's μ = 0.1, β = 0,
-//! λ = 15, σ = 10 (`potts-learned`): on the 14 noisy meshes its AUC, swept over 50 biases in
-//! [−2, 1] as section 6.3, is 89.3 % against 91.7 % for the decision value itself (`learned`,
-//! the default method of [`super::detect_edges`]), with the shipped model; 91.3 % against
-//! 92.8 % with leave-one-out models (`examples/meshfeat_learned.rs`). (With the tangent-plane
-//! estimator's noise-adapted acceptance angle: 90.0 % against 92.4 %, and 91.5 % against
-//! 93.2 % leave-one-out; `potts-tangent` 90.09 % against 90.05 %.) (A bias sweep gives a
-//! coarser ROC than a score, which costs some area; on noisy fandisk the F1 at bias 0 is
-//! about the same for both.)
+//! **Parameters.** With the paper's μ = 2 the pairwise reward of two aligned feature edges
+//! (−2 α) outweighs the data cost of labelling noisy flat edges as features, and on crease's
+//! meshes every edge ends up a feature. The default μ = 0.05 keeps the labelling close to
+//! thresholding the data angle at θ_true (the same AUC and F1 as thresholding; larger μ
+//! lowered the F1). So in crease's measurements the global energy does not beat plain
+//! thresholding of its own data term, and the same holds for the SVM data term of equation 2
+//! with the paper's μ = 0.1, β = 0, λ = 15, σ = 10 (`potts-learned`) against the decision
+//! value itself. Figures (`examples/meshfeat_table2.rs`, `examples/meshfeat_learned.rs`):
+//! `docs/experiments/mesh-edges-tangent.md`.
 
 use rayon::prelude::*;
 

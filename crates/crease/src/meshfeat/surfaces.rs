@@ -8,14 +8,14 @@
 //! to half an edge length on our meshes) every local estimator, the dihedral angle of
 //! filtered normals as much as the multi-scale tangent-plane features of section 4, reads a
 //! neighbourhood a few edges wide, where a shallow crease and the facets of a coarse curved
-//! tessellation look alike (cup.off: its 45–60° creases and the 10–30° facet edges of its
-//! toroidal rims both come out near 14° after filtering). A fitted plane, cylinder, cone,
+//! tessellation look alike (on cup.off its creases and the facet edges of its toroidal rims
+//! come out at the same filtered angle). A fitted plane, cylinder, cone,
 //! sphere or torus averages the noise over thousands of vertices, and a CAD part is made of
 //! them: where two fitted surfaces meet, the line is where the vertices are on both.
 //!
 //! **The score.** Every vertex v gets the surface s(v) of its segmentation (or none). For an
 //! edge e = (a, b), the candidate surfaces are those of the vertices within two rings of a
-//! and b (one ring: 0.02 points less at 0.5 % noise on every draw but one). For every pair
+//! and b (one ring scored a little lower on every noise draw but one). For every pair
 //! (A, B) of them,
 //!
 //! s_AB(e) = exp(−Σ_{v ∈ {a, b}} (d_A(v)² + d_B(v)²) / (8 W² σ̂²)) · min(1, ∠(n_A, n_B) / θ_t),
@@ -30,26 +30,19 @@
 //! its vertices an edge length off one of the surfaces (times the sine of the angle). The
 //! edge's score is the largest s_AB, 0 when fewer than two surfaces are around.
 //!
-//! **Measured** (`examples/meshfeat_learned.rs`, the 11 meshes of Table 2, mean AUC of `fused`
-//! without → with this term at the default weight 0.3): clean 100.00 → 100.00 %, noise 0.2 %
-//! of the largest side 99.71 → 99.74 %, 0.5 % (seed 7) 98.86 → 99.04 % (cup 97.16 → 98.71,
-//! fandisk 98.42 → 98.54, fillet-chamfer-cone 99.14 → 99.34; on block and sharp_sphere the
-//! segmentation finds few of the small faces and little changes); noise seeds 1 / 2 / 3:
-//! 98.91 / 98.88 / 98.96 → 99.00 / 99.08 / 99.07 %. Alone, the score ranks the noisy cup's
-//! edges with AUC 99.2 % and fandisk's with 83.7 %. The figures that follow were
-//! measured with the candidates of one ring (99.02 % at 0.5 %, seed 7): the weight
-//! 0.2 / 0.3 / 0.4 / 0.5 gave 99.00 / 99.02 / 99.03 / 99.02 % at 0.5 % (W = 1); W = 0.7 / 1 /
-//! 1.5 / 2 gave 99.00 / 99.02 / 99.01 / 98.98 % (weight 0.3); the angle cap at 12°, 25° or
-//! 50°, or none, 99.01–99.02 %; a per-surface noise (each surface's RMS residual) instead of
-//! σ̂ 99.02 %; lowering edges inside one surface 99.01–99.03 %: none of these is kept.
+//! **Measured** (`examples/meshfeat_learned.rs`, the 11 meshes of Table 2): the term raises
+//! the mean AUC of `fused` on noisy meshes, most on cup; on block and sharp_sphere the
+//! segmentation finds few of the small faces and little changes. Other weights, widths W,
+//! angle caps and noise estimates scored within a few hundredths of a point and were not kept
+//! (`docs/experiments/mesh-edges-fused.md`).
 //!
 //! **Why the cloud path.** The mesh path of the segmentation ([`crate::segment::segment_mesh`])
 //! keeps the paper's tolerances of equations 4 and 5 (0.5 l̄, 8°), which the noise of the
-//! protocol exceeds: it split the noisy cube into 1789 surfaces and its edge score ranked no
-//! better than chance (AUC 51 %). The cloud path widens them to the measured noise
-//! (`SegmentParams::adapt_to_noise`) and found 8 surfaces on the same cube.
+//! protocol exceeds: it split the noisy cube into more than a thousand surfaces and its edge
+//! score ranked no better than chance. The cloud path widens them to the measured noise
+//! (`SegmentParams::adapt_to_noise`) and finds a handful on the same cube.
 //!
-//! **Large meshes.** The seed fits dominate the segmentation (15 of 19 s for 333k points), so
+//! **Large meshes.** The seed fits dominate the segmentation, so
 //! above [`IntersectionParams::max_points`] vertices only a pseudo-random subset of that size
 //! (a hash of the vertex index, so independent of the thread count) is segmented, and every
 //! other vertex takes the surface nearest to it among those of the segmented vertices within

@@ -28,38 +28,29 @@
 //! normals are off by 20–30°, so the 23° test keeps mostly the faces that agree with the noisy
 //! seed and θ̂ʳ stays about as noisy as the dihedral angle. Starting instead from the
 //! area-weighted mean normal of all the faces of each side in the sphere (then growing exactly
-//! as the paper does) lifts the per-edge AUC of θ̂ʳ (mean of r = 4, 7, 10 %) on the noisy
-//! synthetic cube from 90.6 % to 98.7 % and on noisy fandisk from 85.7 % to 93.9 %, and the
-//! mean over the 14 noisy meshes of `examples/meshfeat_table2.rs` from 80.5 % to 89.2 %
-//! (measured without the smallest radius below; with it: 98.7 %, 93.8 %, 87.5 %). The price
-//! is localisation: beside a crease the mean mixes both surfaces, so lines come out a few
-//! edges wide (F1 0.5–0.6 on the noisy synthetic parts, limited by precision) and on clean
-//! meshes the paper's seeds are exact where the mean initialisation is not (clean mean AUC
-//! 97.2 % against 100 % for the dihedral angle). [`TangentParams::mean_init`] = false gives the paper's
-//! seeds; [`TangentParams::iterations`] > 1 regrows from the previous normals (measured: no
-//! gain).
+//! as the paper does) raises the AUC of θ̂ʳ on noisy meshes a lot. The price is localisation:
+//! beside a crease the mean mixes both surfaces, so lines come out a few edges wide, and on
+//! clean meshes the paper's seeds are exact where the mean initialisation is not.
+//! [`TangentParams::mean_init`] = false gives the paper's seeds;
+//! [`TangentParams::iterations`] > 1 regrows from the previous normals (no gain measured).
 //!
 //! **Acceptance angle adapted to the noise (crease's change, on by default).** The 23° of
 //! section 6.3 presumes face normals that scatter much less than 23° about their surface's
-//! normal. At the noise of section 6.1 on a fine or elongated mesh they do not: the median
-//! angle between adjacent face normals is 29° on noisy fandisk, 53° on the noisy cylinder and
-//! 55° on the noisy bar (σ = 0.5 % of the largest side is half an edge length there), so the
+//! normal. At the noise of section 6.1 on a fine or elongated mesh they do not (the median
+//! angle between adjacent face normals exceeds 23° on noisy fandisk, cylinder and bar), so the
 //! test rejects faces of the edge's own surface at random and the region normals are truncated
-//! means biased towards whatever the seeds say (on the noisy bar the flat edges' θ̂ʳ has a
-//! median of 31°). The angle between two independent noisy normals is about √2 times the
-//! scatter of one, so [`TangentParams::noise_accept`] = 1.5 × the mesh's median adjacent-face
-//! angle (≈ 2 scatters of a face about its surface) is the gate, never below the paper's 23°
-//! (so clean meshes, whose median is a few degrees, are unchanged) and never above 85° (faces
-//! of a perpendicular surface stay out). Measured with `examples/meshfeat_table2.rs` (mean of
-//! the 3 default scales), noisy AUC of θ̂ʳ: mean over the 14 meshes 87.5 % → 90.1 %, the ABC
-//! model 79.9 % → 90.4 %, cylinder 90.4 % → 97.7 %, bar 81.1 % → 86.3 %, sharp_sphere 88.1 % →
-//! 86.8 % (the one that loses); clean AUCs unchanged. Factors 1 and 2 gave 89.1 % and 89.5 %.
+//! means biased towards whatever the seeds say. The angle between two independent noisy
+//! normals is about √2 times the scatter of one, so [`TangentParams::noise_accept`] = 1.5 ×
+//! the mesh's median adjacent-face angle (≈ 2 scatters of a face about its surface) is the
+//! gate, never below the paper's 23° (so clean meshes, whose median is a few degrees, are
+//! unchanged) and never above 85° (faces of a perpendicular surface stay out). It raises the
+//! noisy mean AUC of θ̂ʳ (factor 1.5 above 1 and 2) and leaves the clean AUCs unchanged.
 //!
 //! **Smallest sphere (crease's addition).** r is a fraction of the bounding box's smallest
 //! side (section 4); on a fine or flat mesh r = 4 % can be shorter than an edge, and the sphere
 //! then holds no face but the edge's own two, so θ̂ʳ is the dihedral angle with all its noise
-//! (a noisy 60 × 60 grid: 512 false sharp edges at 65° instead of 0). Radii are therefore at
-//! least [`TangentParams::min_edge_lengths`] = 2 mean edge lengths.
+//! (hundreds of false sharp edges on a noisy flat grid). Radii are therefore at least
+//! [`TangentParams::min_edge_lengths`] = 2 mean edge lengths.
 //!
 //! **Sharing work across scales and bounded cost (crease's addition).** The faces in a sphere
 //! grow as r² / (mean face area): at r = 28 % of a part on a 1M-edge mesh that is ~10⁵ faces per
@@ -72,10 +63,10 @@
 //! and the cost per edge and scale is bounded otherwise. Scales that fall on the same level are
 //! gathered once at the largest of them and sorted once; the smaller scales read the same
 //! order filtered by distance. The per-edge computation is independent of every other edge,
-//! so the result does not depend on the thread count. Measured (release, 2 cores shared with
-//! other jobs, load ≈ 5) on a noisy fillet-chamfer-cone mesh, default 3 scales: 100k edges
-//! 2.1 s, 1M edges 16 s (budget 384: 66 s; the Table 2 AUCs are the same with 128 and 384);
-//! the 9 scales of section 4 at 1M edges: 50 s.
+//! so the result does not depend on the thread count. The default budget of 128 faces gives
+//! the same Table 2 AUCs as 384 at a quarter of the time.
+//!
+//! Figures of every choice above: `docs/experiments/mesh-edges-tangent.md`.
 
 use rayon::prelude::*;
 
@@ -480,9 +471,8 @@ fn edge_angles(
 /// separating plane) whose squared distance to the midpoint is at most `r2`, starting from the
 /// normals `init`, with the edge's two faces in their regions from the start if `seeds`.
 /// (Testing the two faces like the other candidates instead, with the mean initialisation,
-/// was measured: 17 instead of 147 false edges on the 0.5 %-noise grid, but the mean AUC of
-/// Table 2 fell from 87.5 % to 85.0 % on the noisy meshes and from 97.2 % to 94.7 % on the
-/// clean ones.)
+/// gave fewer false edges on a noisy grid but a lower mean AUC of Table 2, clean and noisy:
+/// `docs/experiments/mesh-edges-tangent.md`.)
 #[allow(clippy::too_many_arguments)]
 fn grow(
     em: &EdgeMesh,

@@ -12,35 +12,21 @@
 //! been manually set": feature lines, not one angle for every mesh. A CAD mesh's dihedral
 //! histogram has a smooth mode near 0°, the tessellation of curved faces, and a feature mode,
 //! the creases. The threshold lies in the valley between them, read on the 5° histogram and
-//! checked by eye (`crease edges --method dihedral --threshold T --lines` and `crease render`).
-//! Edges per 5° bin from 0°:
-//! * fandisk: 20264, 518, 33, **1**, 56, 99, … — 17.5° (865 feature edges; 25° cut 56 edges
-//!   of its shallow creases);
-//! * cup: …, 333, 22, 5, 6, **4**, 14, 166, … — 42.5°. It is the paper's cup, with the same 17010
-//!   edges, and the paper labels 381 feature edges; this threshold gives 382, 25° gave 417;
-//! * sharp_sphere: …, 244, 19, 8, 8, **4**, 12, … — 42.5°;
-//! * cylinder (0 from 10° to 90°), bar (0 from 5° to 45°) and block (a low plateau of 15, 17, 11,
-//!   12 from 15° to 35°): 25°, as before;
-//! * no feature lines, so not scored, as the paper's sphere and torus (0 feature edges, "-" in
-//!   its Table 2):
-//!   - torus.off, a smooth torus of 12 × 24 facets whose 25–35° creases are the facets;
-//!   - rocker-arm.off and screwdriver.off, smooth scanned shapes whose histograms fall steadily,
-//!     with no valley (rocker-arm: 12249, 7385, 4083, 2707, 1643, 960, …).
+//! checked by eye (`crease edges --method dihedral --threshold T --lines` and `crease render`):
+//! 17.5° for fandisk, 42.5° for cup (the paper's cup: this gives the paper's count of feature
+//! edges within one) and sharp_sphere, 25° for cylinder, bar and block. The smooth torus and
+//! the two smooth scans (rocker-arm, screwdriver) have no feature lines and are not scored, as
+//! the paper's sphere and torus ("-" in its Table 2). The histograms, and the earlier rule of
+//! 25° for every mesh (the examples' `--label-degrees 25`):
+//! `docs/experiments/mesh-edges-ground-truth.md`.
 //!
-//! **Sliver faces narrower than the noise** ([`sliver_edges`]). block.off is a CAD tessellation
-//! with 290 sliver faces (of 4272) less than 0.3 % of an edge wide, most of them along its
-//! creases: half of its 739 feature edges border one, with clean dihedral angles anywhere from
-//! 38° to 167° (the other half: 85–92°). Both long sides of such a sliver lie on the crease
-//! within its width, and its clean normal alone decides which of them the threshold labels. At
-//! noise of σ, a face narrower than σ has no measurable normal left, and no detector can tell
-//! which side was labelled: the examples report AUC also with the edges of faces narrower than
-//! σ (in the clean mesh) not scored. At σ = 0.2 % of the largest side that leaves out 623 of
-//! block's edges, and also 581 of sharp_sphere's, 108 of the ABC model's and 9 of cup's, the
-//! long thin faces of their curved patches; at 0.5 % also 2532 of bar's.
-//!
-//! Until 2026-12-03 every classic mesh was labelled at 25°. That labelled the torus's facets
-//! and the two scans' tessellation. The examples keep that rule behind `--label-degrees 25`, so
-//! the old figures can still be reproduced.
+//! **Sliver faces narrower than the noise** ([`sliver_edges`]). A CAD tessellation such as
+//! block.off has sliver faces along its creases, far narrower than an edge. Both long sides of
+//! such a sliver lie on the crease within its width, and its clean normal alone decides which
+//! of them the threshold labels. At noise of σ, a face narrower than σ has no measurable normal
+//! left, and no detector can tell which side was labelled: the examples report AUC also with
+//! the edges of faces narrower than σ (in the clean mesh) not scored (how many, per mesh: the
+//! same file).
 
 use std::path::Path;
 

@@ -20,33 +20,22 @@
 //! minimiser of its own quadratic, n_f ← normalise((A_f / Ā) n⁰_f + λ Σ_e w_e n_g) (a Jacobi sweep,
 //! parallel over the faces, so the result does not depend on the thread count).
 //!
-//! **Choices, measured** (mean AUC over the 11 meshes of `examples/meshfeat_table2.rs`, of
-//! the `fused` score with this angle averaged with the bilateral one, clean / 0.2 % / 0.5 %
-//! noise of the largest side; SVM weight 0.2, before the line smoothing of [`super::line`]):
+//! **Choices** (each measured with `examples/meshfeat_table2.rs` and
+//! `examples/meshfeat_learned.rs`; figures in `docs/experiments/mesh-edges-filtered-angle.md`):
 //! - A fixed number of sweeps, [`TvParams::sweeps`] = 20, started from the normals after one
-//!   bilateral iteration: 100.00 / 99.67 / 98.70 %. Started from the second iteration, 20 /
-//!   30 / 50 / 80 sweeps scored 98.66 / 98.68 / 98.68 / 98.63 % at 0.5 %. Running towards
-//!   convergence loses on curved faces, where the total variation merges the facets of a
-//!   coarse tessellation into flat pieces with false jumps between them (the staircase
-//!   effect): with the edge-length weight and from the raw normals, the angle averaged with
-//!   the bilateral one (without the SVM) scored 98.24 % after 100 sweeps and 98.01 % after 300.
-//! - λ = 4. Until 2026-12-04, λ was 1 × the mean edge length against the raw areas, which
-//!   made the balance depend on the mesh's units: λ / Ā ranged from 1.7 (block.off, 38 units
-//!   wide) to 132 (the synthetic parts, 1 unit wide) on the meshes of the table, and a mesh
-//!   scaled by 1000 got another angle. With the areas divided by their mean, λ = 2 / 4 / 8 /
-//!   16 / 32 scored 98.85 / 98.86 / 98.86 / 98.86 / 98.86 % at 0.5 % noise, 99.71–99.72 % at
-//!   0.2 %, 99.56 % at 0.289 % and 100.00 % clean (`fused`): with ε this small the weights
-//!   w_e of the faces that agree dominate the data term whatever λ, and the sweeps count
-//!   decides how far the flow goes.
-//! - ε = the chord of 1°: 0.5° and 3° scored within 0.1 points, 3° lower on clean meshes.
-//! - A uniform edge weight rather than the paper's edge length: +0.1 point at 0.5 % (long
-//!   edges of CAD slivers otherwise couple faces that share little but an edge).
+//!   bilateral iteration. Running towards convergence loses on curved faces, where the total
+//!   variation merges the facets of a coarse tessellation into flat pieces with false jumps
+//!   between them (the staircase effect).
+//! - λ = 4, against the areas divided by their mean, so that the balance does not depend on
+//!   the mesh's units (λ from 2 to 32 scores the same: with ε this small the weights w_e of the
+//!   faces that agree dominate the data term whatever λ, and the sweeps count decides how far
+//!   the flow goes).
+//! - ε = the chord of 1° (0.5° and 3° within 0.1 points of AUC, 3° lower on clean meshes).
+//! - A uniform edge weight rather than the paper's edge length: long edges of CAD slivers
+//!   otherwise couple faces that share little but an edge.
 //!
-//! The angle alone is not better than the bilateral one (mean AUC 97.42 % against 97.42 % at
-//! 0.5 %): it wins on fine meshes (the ABC model 93.7 → 99.6 %, fandisk 96.9 → 98.8 %; 20
-//! sweeps from the second bilateral iteration) and loses on coarse curved tessellations (cup
-//! 96.3 → 94.4 %, block 94.2 → 88.7 %), so
-//! [`super::filtered_dihedral`] averages the two.
+//! The angle alone is not better than the bilateral one: it wins on fine meshes and loses on
+//! coarse curved tessellations, so [`super::filtered_dihedral`] averages the two.
 
 use rayon::prelude::*;
 use serde::Serialize;

@@ -36,29 +36,17 @@
 //! `2 th_pos · l̄` for the positions of section 6, `simpler_floor · l̄` in the model selection,
 //! and, not in the paper, the crease-band RMS floor `1e-6 l̄`, the cap `3 l̄` of the widened
 //! tolerance and the least vertex weight `1e-12 l̄²`; angles are dimensionless. The fits use
-//! relative steps and tolerances only (see [`fit`]; the damping floor of their
-//! Levenberg–Marquardt refinement was an absolute 1e-12 until it was found to change the
-//! segmentation of a part written in metres instead of millimetres, and their algebraic
-//! circle, sphere and quadric fits were solved in raw coordinates, whose conditioning depends
-//! on the units). A scaled input therefore gives the same labels and the same surfaces,
-//! scaled: bit for bit when the factor is a power of two, up to round-off otherwise (tests
-//! `segmentation_is_independent_of_the_mesh_units` and
+//! relative steps and tolerances only (see [`fit`]). A scaled input therefore gives the same
+//! labels and the same surfaces, scaled: bit for bit when the factor is a power of two, up to
+//! round-off otherwise (tests `segmentation_is_independent_of_the_mesh_units` and
 //! `cloud_segmentation_is_independent_of_the_units`). Round-off itself decides where the input
 //! is so noisy that seeds hold a handful of vertices, or where a fit has a family of equally
 //! good optima: fits through as many points as they have unknowns (4-vertex cylinder seeds), a
 //! cone fitted to 18 noisy points, a torus fitted to a spherical patch (a spindle torus,
 //! `R < r`, of any axis), and the last bits of the coordinates pick the optimum; and on exact
 //! data, where a crease vertex lies on both its surfaces and symmetric parts have regions of
-//! equal size. Measured on the synthetic meshes (labels changed by scaling by 1/1000, and by one
-//! ulp on every seventh coordinate at the same scale): box-hole with noise 0.2 of the spacing
-//! 1365 and 1423 of 15758; fillet-chamfer-cone with noise 0.2 (41 % of the faces assigned) 385
-//! and 0 of 8778; the rounded cube with noise 0.05, where a residual seed over a spherical
-//! corner is fitted a spindle torus, 2323 and 0 of 17328; noise-free, the rounded cube 28 and
-//! 14, two-cylinders and box-hole meshed at 1/25 of their size 538 and 538, 0 and 1368
-//! (surfaces of equal size swapping their ids), fillet-chamfer-cone at 1/25 76 and 218 (its
-//! narrow chamfer typed a plane, or a cone and a cylinder). The other parts with noise up to
-//! 0.1 gave the same labels at 1000, 1/1000 and 1e-6 but for a face lying exactly between two
-//! surfaces. At the powers of two 2^10 and 2^-10 all were the same bit for bit.
+//! equal size. How many labels that changes on the synthetic meshes, and the absolute
+//! tolerances this replaced: `docs/experiments/segmentation.md`.
 //!
 //! Surface-type codes (PLY `surface_type`, uchar) are those of
 //! [`crate::geometry::SurfaceType`]: plane 0, cylinder 1, cone 2, sphere 3, torus 4,

@@ -27,11 +27,11 @@
 //! (about 90 points) never entering a sharp point.
 //!
 //! **Sharp points: why more than `th_se`.** Across a crease the quadric blends the two faces,
-//! and the first-pass threshold alone does not stop that on clouds: measured on the cube
-//! (20k points, exact normals), only about half of the points within one spacing of an edge
-//! pass `th_se` (the fit's linear terms tilt the plane and halve the apparent bend), and the
-//! graph's edges (up to about two spacings) jump over the thin band that does, so the second
-//! pass of 2900 points 2–5 spacings away still reached across (normals 20–60° off). So, like
+//! and the first-pass threshold alone does not stop that on clouds: only about half of the
+//! points near an edge pass `th_se` (the fit's linear terms tilt the plane and halve the
+//! apparent bend), and the graph's edges jump over the thin band that does, so second-pass
+//! fits a few spacings away still reach across (measured on the synthetic cube, see
+//! `docs/experiments/segmentation.md`). So, like
 //! the mesh path's dihedral rule (`crease_angle_degrees`), a point is also sharp when the
 //! normal `n` turns towards a graph neighbour faster than the crease angle per mean edge
 //! length: `∠(n_i, n_j) > 30° · |p_i − p_j| / l̄` (unsigned angle). Every graph edge that
@@ -45,12 +45,13 @@
 //! point therefore joins the region of a graph neighbour whose surface is nearest to it, if
 //! that distance passes equation 4 (no normal test), over up to `face_passes` rounds
 //! (Jacobi-style: each round reads the previous one, so the result does not depend on the
-//! thread count). Measured on the cube with estimated normals: 1.8 % of the points were left
-//! unassigned without this, 0.01 % with it.
+//! thread count). On the synthetic cube this leaves almost no point unassigned
+//! (`docs/experiments/segmentation.md`).
 //!
 //! **Order.** The work walks the graph; on a cloud in random order every step is a cache miss,
 //! so the cloud is processed in Morton order and the per-point results are put back into the
-//! input order (curvature stage at 100k points: 4.4 s → 1.8 s on one thread).
+//! input order (the curvature stage more than twice as fast, see
+//! `docs/experiments/segmentation.md`).
 //!
 //! **Areas.** A point stands for the area `π r_k² / k`, `r_k` being the distance to its k-th
 //! nearest neighbour (the k-nearest-neighbour density estimate); a surface's area is the sum

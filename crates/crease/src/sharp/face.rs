@@ -4,11 +4,10 @@
 //!
 //! Tran et al. take N(i) as the k nearest points (section 2.1) and the projected distance of
 //! equation 3 assumes they sample one surface around p_i. On a plate a few spacings thick the
-//! k = 12..40 nearest points include the opposite face (measured with the PCEDNet models' stored
-//! normals: 52 % of the points of model 7010, plates 1.8 spacings thick, have such a neighbour
-//! among their 12 nearest, 91 % on 7038, blades 1.3 spacings thick, where they make 34–38 % of
-//! the 12 to 40 nearest), the neighbourhood's centroid lies between the faces and every point of
-//! the plate looks sharp. This module drops those neighbours before the measure is taken.
+//! k = 12..40 nearest points include the opposite face (on most points of the thin-plate
+//! PCEDNet models, see `docs/experiments/sharp-points.md`), the neighbourhood's centroid lies
+//! between the faces and every point of the plate looks sharp. This module drops those
+//! neighbours before the measure is taken.
 //!
 //! **The test.** Every point gets a small-scale normal m_i (`face_normals`): the PCA normal of
 //! the point and its [`FACE_K`] nearest neighbours (few enough that the opposite face is rarely
@@ -31,21 +30,13 @@
 //! Scale s then uses the neighbours that pass the test among the s nearest (the neighbourhood
 //! keeps the radius of the s-nearest ball), so one kNN query still serves every scale.
 //!
-//! **Cost** (`examples/sharp_timing.rs`, all eight scales on 1M points of the synthetic cube in
-//! Morton order, 2 threads, best of 3, on a machine shared with other work): 2.95 s without
-//! the test, 3.82 s with it (+29 %: three 3 × 3 eigenproblems per point for the small-scale
-//! normals and one test per neighbour); peak memory 546 → 559 MB (the normals, 24 B a point).
+//! **Cost**: three 3 × 3 eigenproblems per point for the small-scale normals and one test per
+//! neighbour, and 24 B a point for the normals (timed in `docs/experiments/sharp-points.md`).
 //!
-//! **Measured** on the 8 clean PCEDNet ABC models (see [`super`] for the figures per model): the
-//! test with the stored (exact) normals reaches median MCC 0.802, with the small-scale PCA
-//! normals 0.796. Variants measured and not kept: small-scale normals at 5 or 8 neighbours
-//! (0.792, 0.791), no refit (0.689), normals refitted over the one-face neighbourhood at 8–20
-//! neighbours (0.707–0.742: larger neighbourhoods blend the two faces of an edge), a plane through
-//! p_i and two neighbours with the most inliers (a deterministic RANSAC over the pairs of the 6
-//! or 8 nearest: 0.759–0.766; better on the blades of 7038, 0.24 → 0.46, worse next to the edges
-//! of 7034 and 6944, where it takes the other face's plane), the first s survivors of 64
-//! candidates instead of the survivors among the s nearest (no better with exact normals, and a
-//! larger kNN query).
+//! The small-scale PCA normals score nearly as well as exact ones on the clean PCEDNet models;
+//! other normals (fewer neighbours, no refit, a refit over the one-face neighbourhood, a
+//! RANSAC plane) and taking the first s survivors of a larger query scored lower or cost more
+//! (`docs/experiments/sharp-points.md`).
 
 use rayon::prelude::*;
 

@@ -18,16 +18,17 @@
 //! exactly when its sharpness is ≥ 1, and ranking points by it gives ROC curves.
 //!
 //! **Choices where the paper is open** (each measured on the synthetic parts and the PCEDNet
-//! benchmark, see `tests/sharp.rs`):
+//! benchmark, see `tests/sharp.rs`; the figures and the variants tried are in
+//! `docs/experiments/sharp-points.md`, `sharp-noise.md` and `sharp-surfaces.md`):
 //! * N(i) is the point and its k nearest other points (as the PCA normals of
 //!   [`crate::estimate::normals`]). Equation 1's Gaussian weights are available
 //!   ([`SharpParams::pca_weight`], σ = 2 × the neighbourhood's RMS radius instead of σ = k, see
-//!   [`PcaWeight`]) but off by default: measured, they do not change the accuracy and cost
-//!   three times the time.
+//!   [`PcaWeight`]) but off by default: they do not change the accuracy and cost three times
+//!   the time.
 //! * Thin plates: when a neighbourhood holds both faces of a plate thinner than itself, its
 //!   centroid lies between the faces and every point of the plate gets a large projected
-//!   distance (on the PCEDNet model 7038, a propeller with blades 1.3 spacings thick, Otsu then
-//!   flags 62 % of the points). Two stages keep the neighbourhoods on the point's own face:
+//!   distance (Otsu then flags most of a thin plate). Two stages keep the neighbourhoods on the
+//!   point's own face:
 //!   1. [`SharpParams::one_face`] (clouds measured noise-free): every neighbour on another sheet
 //!      parallel to the point's own (the opposite face of a plate, the facing wall of a slot) is
 //!      dropped by a test on small-scale normals and chord angles ([`face`]); scale k keeps the
@@ -36,26 +37,10 @@
 //!   2. what remains is tested for two flat parallel groups along the normal, and only the
 //!      point's own group is used (catches the plates whose small-scale normals were wrong).
 //!
-//!   Measured (median MCC of the 8 clean PCEDNet ABC models, `examples/sharp_pcednet.rs`):
-//!   stage 2 alone 0.644 (0133 0.927, 6944 0.602, 7010 0.540, 7023 0.947, 7029 0.935, 7031
-//!   0.214, 7034 0.687, 7038 0.245); both 0.783 (0.926, 0.684, 0.641, 0.947, 0.941, 0.214,
-//!   0.883, 0.363); stage 1 alone 0.796 (0.926, 0.718, 0.615, 0.947, 0.940, 0.214, 0.874,
-//!   0.238), a higher median but lower on four models and a lower mean (0.684 against 0.700),
-//!   so both are kept. Neither stage 0.416. The remaining low models: 7031's ground truth
-//!   marks only its two holes (64 points) and not the rounded outline (small fillets that the
-//!   cloud samples as sharp edges, 1100 of the 1241 detections); on the plates (7010, 7038) the
-//!   truth labels both edges of rims 1.3–1.8 spacings wide, which the thinning reduces to one
-//!   line (7038 unthinned: 0.59 with exact normals, thinned 0.48); the thinning now compares
-//!   only points displaced to the same side (module `thin`), which keeps both edges: median 0.784
-//!   (0133 0.924, 6944 0.684, 7010 0.643, 7023 0.947, 7029 0.940, 7031 0.196, 7034 0.885, 7038
-//!   0.458; noisy 0.231: 0133 0.410, 6944 0.111, 7023 0.383, 7029 0.382, the others
-//!   unchanged). On 6944 stage 2 costs 0.03 (0.716 without it: it drops a parallel sheet about
-//!   0.7 spacings off next to some edges, 357 true detections lost) but is what keeps 7038 at
-//!   0.458 (0.335 without it); a test that the far group overlaps the near one in the tangent
-//!   plane (to tell a plate from a step) only trades the two against each other. On the noisy
-//!   clouds the
-//!   chord test drops neighbours at random (median 0.231 → 0.205), hence it is off where
-//!   the cloud is measured noisy ([`noise::NOISY_RATIO`]), and the noisy figures are unchanged.
+//!   Both stages are kept: stage 1 alone has the higher median MCC on the clean PCEDNet
+//!   models but loses on four of the eight, and stage 2 is what keeps the propeller blades of
+//!   model 7038. On noisy clouds the chord test of stage 1 drops neighbours at random, hence
+//!   it is off where the cloud is measured noisy ([`noise::NOISY_RATIO`]).
 //! * [`SharpParams::thin`]: detections are thinned across the line to one or two points,
 //!   comparing (clouds) only neighbours displaced to the same side, see the module `thin`.
 //! * [`SharpParams::density_invariant`]: the projected distance is a length, so on an unevenly
@@ -71,43 +56,25 @@
 //!   (section 4.5) and degrades from 4–5 % noise on (section 4.4). The noise is measured from the
 //!   data ([`noise::noise_ratio`]: lower decile of the 7-point plane residual over the spacing);
 //!   above [`noise::NOISY_RATIO`] the per-point decisions are replaced by the Potts labelling of
-//!   [`potts`] (vidal2011 equation 1) with [`Regularize::noisy`]. Measured on the PCEDNet ABC
-//!   models: the ratio is 0.000 on all 8 clean clouds (so they keep the plain detector, median
-//!   MCC 0.644 unchanged, measured before the one-face stage) and 0.16–0.22 on all 8 noisy ones, whose median MCC goes from 0.136 to
-//!   0.231 (0133 0.217 → 0.406, 6944 0.042 → 0.110, 7010 0.115 → 0.234, 7023 0.197 → 0.376,
-//!   7029 0.304 → 0.383, 7031 0.038 → 0.052, 7034 0.157 → 0.229, 7038 −0.019 → −0.002). The
-//!   synthetic parts with 0–5 % noise stay below half the switch value.
+//!   [`potts`] (vidal2011 equation 1) with [`Regularize::noisy`]. The ratio separates the
+//!   clean PCEDNet clouds from the noisy ones by two orders of magnitude, and the synthetic
+//!   parts with 0–5 % noise stay below half the switch value; the labelling raises the noisy
+//!   clouds' MCC but would lower the clean ones'.
 //!
 //! * [`SharpParams::surfaces`] (clouds, projected distance; on by default): after the labelling
 //!   above, the points whose neighbourhood the cloud's segmentation into analytic surfaces
 //!   explains are decided by their distance to the intersection of two surfaces meeting at more
 //!   than 30° ([`surfaces`]): a fitted surface averages the noise over many points, and a
-//!   tangent junction (fillet) has no such intersection. Measured (median MCC over the 8 ABC
-//!   models, `examples/sharp_pcednet.rs`): clean 0.784 → 0.812 (0133 0.924 → 0.840, 6944 0.684
-//!   → 0.785, 7023 0.947 → 0.957, the others within 0.01), noisy 0.231 → 0.332 (0133 0.410 →
-//!   0.653, 6944 0.111 → 0.394, 7023 0.383 → 0.593, 7029 0.382 → 0.531, 7031 0.052 → 0.134;
-//!   the thin plates 7034 and 7038, where the segmentation fails, keep the detector's labels).
-//!   On noisy clouds the points of thin sheets are then decided by their distance to the
-//!   sheet's rim (module `rim`, from the in-plane offset of the centroid of 80 neighbours, see
-//!   [`surfaces`] step 6): noisy median 0.332 → 0.462 (7034 0.228 → 0.562, 7038 −0.002 →
-//!   0.396, 7023 0.593 → 0.631, 7010 0.271 → 0.289, 6944 0.394 → 0.377, 7029 0.531 → 0.527,
-//!   0133 0.653 → 0.656, 7031 0.134 → 0.135); clean unchanged (0.812). With the segmentation's
-//!   noise measured on its largest seeds ([`crate::segment`]): noisy 0.464 (0133 0.662, 6944
-//!   0.370, 7010 0.289, 7023 0.646, 7029 0.531, 7031 0.129, 7034 0.562, 7038 0.396).
+//!   tangent junction (fillet) has no such intersection. It raises the median MCC on the clean
+//!   and the noisy PCEDNet models; the thin plates, where the segmentation fails, keep the
+//!   detector's labels. On noisy clouds the points of thin sheets are then decided by their
+//!   distance to the sheet's rim (module `rim`, from the in-plane offset of the centroid of 80
+//!   neighbours, see [`surfaces`] step 6).
 //!
-//! **Tried and not kept** (median MCC clean / noisy over the 8 ABC models, or the best MCC a
-//! single threshold on the score reaches, "best"):
-//! * larger fixed scales (k = 24..64, 40..80, 48..96 with Otsu and thinning): clean 0.550 /
-//!   0.481 / 0.390, noisy 0.122 / 0.103 / 0.102, worse on both; with the Potts labelling on the
-//!   noisy clouds, k = 16..48 gave 0.254 and 24..64 0.228 against 0.231 for the paper's scales,
-//!   not a clear gain, so the paper's scales stay;
-//! * a denoised projected distance |(p̄_m − p̄_k)·n_k| (the centroid of the m nearest points
-//!   instead of the point): best-threshold MCC lower at every k and m tried (m = 4, 8, 16) on the
-//!   clean models (e.g. 0133 0.887 → 0.568 at k = 16) and not higher on the noisy ones;
-//! * two planes per neighbourhood (k-planes, 40 neighbours) and the distance of the point to
-//!   their intersection line: best-threshold MCC 0.002–0.81 clean (7023 0.807 against 0.997 for
-//!   the projected distance; thin plates, corners and curved faces break the two-plane model)
-//!   and 0.004–0.34 noisy, below the projected distance.
+//! **Tried and not kept** (`docs/experiments/sharp-points.md`): larger fixed scales than the
+//! paper's (worse on clean and noisy clouds), a denoised projected distance (the centroid of
+//! the m nearest points instead of the point) and the distance to the intersection of two
+//! planes fitted per neighbourhood (both below the projected distance).
 
 pub mod face;
 mod measures;
@@ -161,11 +128,11 @@ pub struct SharpParams {
     pub threshold: ThresholdRule,
     /// Histogram parameters of Otsu's method.
     pub otsu: OtsuParams,
-    /// Weights of the PCA of equation 1. Default [`PcaWeight::Uniform`]: on the PCEDNet ABC
-    /// models the Gaussian weights (σ = 2 × the RMS radius, see [`PcaWeight`]) changed the
-    /// median MCC by less than 0.01 (0.637 weighted, 0.644 uniform), while uniform weights let
-    /// all scales share prefix sums of one neighbourhood's moments (one eigenproblem per scale
-    /// instead of a weighted pass over the points), about 3 times faster.
+    /// Weights of the PCA of equation 1. Default [`PcaWeight::Uniform`]: the Gaussian weights
+    /// (σ = 2 × the RMS radius, see [`PcaWeight`]) hardly change the accuracy, while uniform
+    /// weights let all scales share prefix sums of one neighbourhood's moments (one
+    /// eigenproblem per scale instead of a weighted pass over the points), about 3 times
+    /// faster (see `docs/experiments/sharp-points.md`).
     pub pca_weight: PcaWeight,
     /// Make the length-valued measures independent of the sampling density (see the module
     /// documentation). Default true.
@@ -177,16 +144,15 @@ pub struct SharpParams {
     /// Thin the detections to lines one or two points wide (see the module `thin`); default true.
     pub thin: bool,
     /// Replace the per-point decisions by the Potts labelling of the kNN graph of
-    /// [`potts`] (before thinning; point clouds only). Default `None`: measured on the
-    /// PCEDNet models it raises the noisy median MCC (0.136 → at best 0.231) but lowers the
-    /// clean one (0.644 → 0.587 for that setting), see [`potts`]; hence applied only to clouds
-    /// measured as noisy ([`SharpParams::auto_regularize`]).
+    /// [`potts`] (before thinning; point clouds only). Default `None`: it raises the MCC of
+    /// noisy clouds but lowers that of clean ones (`docs/experiments/sharp-noise.md`); hence
+    /// applied only to clouds measured as noisy ([`SharpParams::auto_regularize`]).
     pub regularize: Option<Regularize>,
     /// Clouds: when [`SharpParams::regularize`] is `None` and the measured noise ratio
     /// ([`noise::noise_ratio`]) exceeds this value, the decisions are regularised with
     /// [`Regularize::noisy`]. Default `Some(`[`noise::NOISY_RATIO`]`)`; `None` never regularises
-    /// automatically. Clean clouds (ratio 0.000 on every clean PCEDNet model) keep the plain
-    /// detector; see the module documentation for the measured effect.
+    /// automatically. Clean clouds keep the plain detector (see the module documentation and
+    /// `docs/experiments/sharp-noise.md`).
     pub auto_regularize: Option<f64>,
     /// Clouds, projected distance: let the analytic surfaces of the cloud's segmentation
     /// decide the points whose neighbourhood they explain ([`surfaces`]), after the
@@ -314,8 +280,7 @@ impl SharpResult {
 ///
 /// Every per-point pass of the cloud detector reads the coordinates of 12 to 40 neighbours;
 /// with the points in input order a scan in sampling (random) order misses the cache on
-/// almost every one of them (measured with perf on 1M points of `crease synth
-/// fillet-chamfer-cone`: one load in the measure pass took 18 % of the detection's samples).
+/// almost every one of them (perf: `docs/experiments/sharp-points.md`).
 /// Run on Morton-sorted points, neighbours are mostly in cache; [`detect_points`] does this and
 /// maps the result back ([`SharpResult::to_input_order`]). Ties between equidistant neighbours
 /// are then broken by Morton rank instead of input index.

@@ -18,42 +18,13 @@
 //! Both pairwise terms are submodular (V(0,0) + V(1,1) ≤ V(0,1) + V(1,0)), so the minimum is
 //! exact.
 //!
-//! **Measured** (median MCC over the 8 PCEDNet ABC models, clean / noisy, thinning after the
-//! labelling unless "no thin"; `(k, λ, α, slope)`):
-//!
-//! | variant                      | clean | noisy |
-//! |------------------------------|-------|-------|
-//! | detector alone (default)     | 0.644 | 0.136 |
-//! | (10, 0.25, 0, 1)             | 0.642 | 0.157 |
-//! | (10, 0.5, 0, 1)              | 0.630 | 0.169 |
-//! | (10, 1, 0, 1)                | 0.366 | 0.149 |
-//! | (10, 2, 0, 1)                | 0.022 | 0.000 |
-//! | (10, 0.5, 0, 1), no thin     | 0.597 | 0.184 |
-//! | (10, 0.25, 0, 1), no thin    | 0.606 | 0.170 |
-//! | (16, 0.5, 0, 1)              | 0.629 | 0.169 |
-//! | (16, 0.5, 0, 1), no thin     | 0.600 | 0.185 |
-//! | (10, 0.5, 0, 2)              | 0.642 | 0.157 |
-//! | (10, 0.25, 0, 2)             | 0.637 | 0.147 |
-//! | (10, 0, 1, 1)                | 0.643 | 0.138 |
-//! | (10, 0.25, 1, 1)             | 0.639 | 0.159 |
-//! | (10, 0.25, 8, 1)             | 0.619 | 0.170 |
-//! | (10, 0.5, 2, 1)              | 0.627 | 0.178 |
-//! | (10, 0.5, 4, 1)              | 0.627 | 0.186 |
-//! | (10, 0.5, 4, 1), no thin     | 0.561 | 0.202 |
-//! | (10, 0.5, 8, 1)              | 0.613 | 0.199 |
-//! | (16, 0.5, 8, 1)              | 0.610 | 0.201 |
-//! | (10, 0.5, 8, 2)              | 0.630 | 0.162 |
-//! | (10, 0.5, 16, 1)             | 0.595 | 0.207 |
-//! | (10, 1, 16, 1)               | 0.587 | 0.231 |
-//!
-//! Pooling helps the noisy models (best median 0.231, from 0.136; per model 0133 0.22 → 0.41,
-//! 7023 0.20 → 0.38, 7029 0.30 → 0.38, 7010 0.12 → 0.23) but always costs on the clean ones
-//! (the Potts price erodes lines one or two points wide, which the reward only partly
-//! offsets), and stays far below the 0.40 hoped for: the per-point sharpness of the noisy
-//! models is too weak a data term. Weighting the line direction by max(0, ln sharpness)
-//! instead of the soft probability was worse (noisy 0.089–0.127). Hence it is applied only to
-//! clouds measured as noisy ([`super::SharpParams::auto_regularize`], setting
-//! [`Regularize::noisy`] = (10, 1, 16, 1)), where clean clouds keep the detector alone.
+//! **Why only on noisy clouds.** Over the settings measured (`docs/experiments/sharp-noise.md`,
+//! a table over k, λ, α and the slope on the PCEDNet models), pooling helps the noisy models
+//! but always costs on the clean ones (the Potts price erodes lines one or two points wide,
+//! which the reward only partly offsets), and its gain stays small: the per-point sharpness
+//! of the noisy models is too weak a data term. Hence it is applied only to clouds measured
+//! as noisy ([`super::SharpParams::auto_regularize`], setting [`Regularize::noisy`] =
+//! (10, 1, 16, 1)), where clean clouds keep the detector alone.
 
 use rayon::prelude::*;
 
@@ -80,10 +51,6 @@ pub struct Regularize {
 }
 
 impl Regularize {
-    /// The setting applied automatically to noisy clouds
-    /// ([`super::SharpParams::auto_regularize`]): k = 10, λ = 1, α = 16, slope 1, the best noisy
-    /// median of the table in the module documentation (0.231), chosen there before the noise
-    /// switch existed (not re-tuned for it).
     /// Errors (`InvalidArgument`) on k = 0 or a negative or non-finite weight.
     pub fn validate(&self) -> Result<()> {
         if self.k == 0 {
@@ -105,6 +72,10 @@ impl Regularize {
         Ok(())
     }
 
+    /// The setting applied automatically to noisy clouds
+    /// ([`super::SharpParams::auto_regularize`]): k = 10, λ = 1, α = 16, slope 1, the best noisy
+    /// setting of `docs/experiments/sharp-noise.md`, chosen before the noise switch existed
+    /// (not re-tuned for it).
     pub fn noisy() -> Self {
         Regularize {
             k: 10,

@@ -17,11 +17,10 @@
 //! (closed forms in [`ratio_at`]): ρ(0) = 0.750, ρ(1) = 0. Inverting ρ gives the distance to
 //! the rim, s = ρ⁻¹(measured ratio) · R, with R the distance to the farthest neighbour.
 //!
-//! Measured on the noisy PCEDNet models (`examples/sharp_pcednet.rs`) with 40, 56, 64 and 80
-//! neighbours: 7034 0.41 / 0.55 / 0.57 / 0.56, 7038 0.29 / 0.36 / 0.38 / 0.40; a mean of the
-//! distances at 24, 32 and 40 neighbours was below 40 alone. The default of [`super::SurfaceRefine::rim_k`]
-//! is 80, twice the largest scale of tran section 4.2, since a sheet's neighbourhood holds both
-//! faces: the same area of the sheet as 40 neighbours on one face.
+//! The default of [`super::SurfaceRefine::rim_k`] is 80, twice the largest scale of tran
+//! section 4.2, since a sheet's neighbourhood holds both faces: the same area of the sheet as
+//! 40 neighbours on one face (fewer neighbours scored lower on the noisy PCEDNet plates, see
+//! `docs/experiments/sharp-surfaces.md`).
 
 use crate::geometry::fit_plane;
 use crate::geometry::{vec3, Point3};

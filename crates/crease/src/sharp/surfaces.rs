@@ -44,33 +44,27 @@
 //!    it is sharp when s(i) < r_i = ([`SurfaceRefine::rim_band`] + σ) h_i, sharpness r_i / s(i).
 //!
 //! Step 5's band: a quarter spacing each side of the line is a band about one point wide, as
-//! the ground truth of the PCEDNet models, whose clouds have their points on the edges; the
-//! best band measured on the clean ones was 0.05–0.25 spacings (median MCC 0.831 at 0.25, 0.810
-//! at 0.5). A randomly sampled cloud leaves gaps in so narrow a band (synthetic cube: tolerant
-//! F1 0.816 at 0.25, 0.925 at 0.5), hence the gap filling up to twice the width (0.920, and
-//! median 0.812 on PCEDNet). A band one spacing wide or more has no gaps to fill: on the noisy
-//! clouds, whose bands are widened by σ (next paragraph), filling cost 0.02–0.09 MCC on every
-//! model explained (0133 0.653 without, 0.568 with; median 0.332 against 0.317). Thinning the
-//! band to the nearest point across the line instead lost 0.05 on the PCEDNet model 6944,
-//! whose ground truth is two points wide. With noise the
-//! distance to the other surface has an error of up to σ, hence + σ (the best bands measured on
-//! the noisy models were 0.65–0.85 spacings for σ = 0.48–0.80).
+//! the ground truth of the PCEDNet models, whose clouds have their points on the edges (the
+//! best band measured on the clean ones). A randomly sampled cloud leaves gaps in so narrow a
+//! band, hence the gap filling up to twice the width; a band one spacing wide or more (noisy
+//! clouds, whose bands are widened by σ) has no gaps to fill, and filling there cost MCC on
+//! every model, hence only where the core band is under a spacing wide. Thinning the band to
+//! the nearest point across the line instead lost on the PCEDNet model whose ground truth is
+//! two points wide. With noise the distance to the other surface has an error of up to σ,
+//! hence + σ (the best bands measured on the noisy models agree).
 //!
-//! Step 6: a plate as thin as the noise (the PCEDNet models 7034 and 7038, 1.0–1.3 spacings
-//! thick, σ ≈ 0.45) has both faces in every neighbourhood. The segmentation leaves a curved one
-//! unassigned (7038: 98 % of its points) and fits a flat one as one surface with no edge (the
-//! bent plate of the tests), and the projected distance there is the noise. Its rims are the
-//! only feature and the in-plane offset sees them. The band: the truth of a rim marks its two
-//! edges, about one spacing each side of the rim's centre line, widened by σ as in step 5
-//! (measured rim_band 0.75 / 1 / 1.25: 7034 0.54 / 0.56 / 0.54, 7038 0.38 / 0.40 / 0.39). The
-//! flatness condition keeps explained points near a missed edge (bent neighbourhoods) with the
-//! surfaces: without it 6944 0.377 → 0.376, 7023 0.631 → 0.625, 7029 0.527 → 0.522; applied to
-//! the unassigned points as well it loses the curved blades of 7038 (0.396 → 0.034). Clean
-//! clouds do not need it: the one-face neighbourhoods of [`super::face`] separate the faces
-//! (clean 7034 0.885 with them, 0.48 with the rim distance instead).
+//! Step 6: a plate as thin as the noise (the PCEDNet models 7034 and 7038) has both faces in
+//! every neighbourhood. The segmentation leaves a curved one unassigned and fits a flat one as
+//! one surface with no edge (the bent plate of the tests), and the projected distance there is
+//! the noise. Its rims are the only feature and the in-plane offset sees them. The band: the
+//! truth of a rim marks its two edges, about one spacing each side of the rim's centre line,
+//! widened by σ as in step 5. The flatness condition keeps explained points near a missed edge
+//! (bent neighbourhoods) with the surfaces; applied to the unassigned points as well it loses
+//! the curved blades of 7038. Clean clouds do not need step 6: the one-face neighbourhoods of
+//! [`super::face`] separate the faces better.
 //!
-//! **Measured** (median MCC over the 8 PCEDNet ABC models, `examples/sharp_pcednet.rs`): see
-//! the module documentation of [`super`].
+//! **Measured** (median MCC over the 8 PCEDNet ABC models, `examples/sharp_pcednet.rs`, each
+//! band and condition above): `docs/experiments/sharp-surfaces.md`.
 
 use rayon::prelude::*;
 

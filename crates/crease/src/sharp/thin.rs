@@ -21,16 +21,11 @@
 //! of one edge the bisector is the same; on the two edges of a rim the bisectors differ by the
 //! angle between the rim face and the plate faces (90° on a square rim). A neighbour is
 //! compared only when u_i·u_j ≥ cos [`SIDE_DEG`] (60°), so each edge of a rim is thinned on
-//! its own. Tran et al. do not thin; this is a choice of ours. Measured on the 8 clean
-//! PCEDNet ABC models (median MCC 0.783 → 0.784): 7038 0.363 → 0.458 (above the unthinned
-//! 0.447), 7010 0.641 → 0.643, 7034 0.883 → 0.885, 6944 0.684, 7023 0.947 unchanged, 0133
-//! 0.926 → 0.924, 7029 0.941 → 0.940, 7031 0.214 → 0.196 (more of its fillet outline, which
-//! the truth does not label, is kept); other angles: 90° (7038 0.426), 72.5° (0.454), 45°
-//! (0.456, 7031 0.179), 30° (0.452, 7031 0.161); the same displacement over the one-face
-//! neighbourhood of [`super::face`] gave the same figures, and skipping the neighbours of
-//! another sheet by [`super::face`]'s test instead (small-scale normals of the two edges of a
-//! rim are rarely parallel) only 7038 0.370. Noisy median 0.231 unchanged (0133 0.406 →
-//! 0.410, 7023 0.376 → 0.383). Meshes keep the plain comparison (not measured there).
+//! its own. Tran et al. do not thin; this is a choice of ours. It keeps both edges of the
+//! propeller blades of PCEDNet model 7038 (60° scored best among 30° to 90°; the one-face
+//! test of [`super::face`] as the criterion did not: the small-scale normals of the two edges
+//! of a rim are rarely parallel); figures in `docs/experiments/sharp-points.md`. Meshes keep
+//! the plain comparison (not measured there).
 
 use rayon::prelude::*;
 

@@ -40,38 +40,18 @@
 //! distances) to a closure while it is in cache, and returns the closure's results in input
 //! order, with no n·k lists at all; [`knn`] is the same query loop writing rows.
 //!
-//! # Measured (release, 1M points on a unit cube's faces, k = 20, 2-core machine)
-//! The machine's speed varies by ±20 % from minute to minute (a shared host), so figures are
-//! best of several runs, and comparisons were run side by side
-//! (`cargo run --release -p crease --example normals_timing`, `scripts/compare-normals.sh`):
-//! * `pca_normals_direct` ([`knn_map_set_unzip`] + PCA) on a Morton-sorted 1M-point file, best
-//!   of 3 in one process: 0.468 s (PCL `NormalEstimationOMP` 1.745 s in the same run of
-//!   `scripts/compare-normals.sh`, 2026-12-02), random input order 0.662 s (PCL 3.74 s); peak
-//!   memory of `crease normals` 116 MB. The day before: 0.587 s (PCL 1.65 s), before the
-//!   subsampled k-th distance estimate, the radix cell sort (`cell_sorted`) and the batched
-//!   eigen solves. On an earlier day, slower machine: the shell search 1.17 s, the first block
-//!   search 0.95 s (PCL 2.34 s).
-//! * Instructions per query (callgrind, 100k points, one thread): the shell search ≈ 7000 for
-//!   kNN alone; the block search 6340 ranked at first, now 4890 ranked ([`knn`], [`knn_map`])
-//!   and 3810 for the unranked set ([`knn_map_set`]). What took the difference, by
-//!   instruction-level profiles: f32→usize bucket indices (a dozen instructions each on
-//!   baseline x86-64), bit counting without `popcnt`, a store-forwarding stall on comparing
-//!   cell coordinates and another on masking the query's own lane, stopping the threshold at
-//!   k + 3 candidates (each spare costs an exact distance and a removal), re-measuring the
-//!   previous neighbourhood for the starting bound. Cells fitted to 1.2 r_k make 99.9 % of
-//!   queries succeed in the block, against 24 % with the power-of-two cells of the bounding
-//!   box's unit (whose side lands anywhere in 0.7 to 1.4 r_k).
-//! * Tried and dropped: an AVX2 version of the block search by function multiversioning with
-//!   plain array loops for the compiler to vectorise (the loops stayed scalar or 4-wide: more
-//!   instructions than the `wide` SSE2 code), a comparison sort of the candidates (quick- /
-//!   insertion sort: 15 % of the time, branch mispredictions), a full selection of the k-th f32 distance per query
-//!   (`select_nth_unstable` on ≈ 108 values: 16 % of the time; the count interpolation replaced
-//!   it). Earlier, for the shell search: kiddo per point 21.5 CPU s random / 9.3 sorted; a
-//!   per-thread cache of cell-table lookups (no gain); cell sides of 0.5x and 2x r_k slower
-//!   than 1x.
-//! * Memory: the points in Morton order (24 B/point), input indices (4 B/point), the cell table
-//!   (≤ 32 B/point), two (code, index) sorts (16 B/point each, one at a time), plus for [`knn`]
-//!   two n·k u32 buffers (160 MB at 1M, k = 20) and for [`knn_map`] only the n results.
+//! **Why these choices.** Cells of 1.2 r_k let almost every query finish in its block, where
+//! the power-of-two cells of the bounding box's unit (a side anywhere in 0.7 to 1.4 r_k) left
+//! most of them to the shell search; the block search takes fewer instructions per query than
+//! the shell search, and the unranked set ([`knn_map_set`]) fewer than the ranked rows. An
+//! AVX2 build, a comparison sort or a full selection of the candidates and other cell sides
+//! were slower, a cache of cell lookups gained nothing. Figures (callgrind, perf, timings
+//! against PCL and Open3D): `docs/experiments/knn-and-normals.md`; speed tables:
+//! `docs/benchmarks.md`.
+//!
+//! **Memory**: the points in Morton order (24 B/point), input indices (4 B/point), the cell
+//! table (≤ 32 B/point), two (code, index) sorts (16 B/point each, one at a time), plus for
+//! [`knn`] two n·k u32 buffers (160 MB at 1M, k = 20) and for [`knn_map`] only the n results.
 
 use std::sync::OnceLock;
 
@@ -311,8 +291,7 @@ where
 /// still reproducible.
 ///
 /// Skipping the ranking (a bucket sort of the candidates and an exact insertion pass) saves
-/// about a fifth of the search: measured with callgrind on 100k cube points, k = 20, 3810
-/// instructions per query against 4890 for [`knn_map`].
+/// about a fifth of the search's instructions (callgrind: `docs/experiments/knn-and-normals.md`).
 ///
 /// Errors as [`knn`].
 pub fn knn_map_set<T, S, I, F>(points: &[Point3], k: usize, init: I, f: F) -> Result<Vec<T>>
@@ -326,7 +305,7 @@ where
 
 /// [`knn_map_set`] for an `f` that returns two values per point, returned as two vectors in
 /// input order, each written in place (unzipping a vector of pairs afterwards cost a third
-/// n-item buffer: at 1M points of PCA normals and eigenvalues, 48 MB of fresh pages and 8 ms).
+/// n-item buffer of fresh pages).
 ///
 /// Errors as [`knn`].
 pub fn knn_map_set_unzip<A, B, S, I, F>(
@@ -457,8 +436,8 @@ impl<A: Send, B: Send> Outputs for (Vec<A>, Vec<B>) {
 /// input order: the result of rank r at position `ids[r]`.
 ///
 /// Each result is written straight to its input position (a parallel scatter into one
-/// buffer) instead of being collected in rank order and permuted afterwards: measured at 1M
-/// points of 48-byte results, that saved a second n-item buffer and 50 to 80 ms. `ids` always is
+/// buffer) instead of being collected in rank order and permuted afterwards, which saves a
+/// second n-item buffer and its time (`docs/experiments/knn-and-normals.md`). `ids` always is
 /// a permutation (it comes from sorting `0..n`); this is verified first, so the unsafe writes
 /// only ever run on a checked permutation, and an error is returned otherwise.
 fn map_to_input_order<O, S, I, F>(ids: &[u32], init: I, f: F) -> Result<O>
@@ -622,10 +601,9 @@ fn gather_fixed(buf: &[u32], ids: &[u32], k: usize) -> Vec<u32> {
 /// curve, a volume), so thinning the cloud by s and the count by s leaves the radius unchanged.
 /// The subsample is chosen by a hash of the index, not by stride, so that structured input
 /// orders (scan lines, grids) are thinned evenly. Only the speed of a grid search depends on
-/// this estimate (its answers are exact for any cell size); measured on 1M cube points in
-/// 11-bit Morton order, the first of the two Morton sorts of [`GridSearch::new`] took 22 ms of
-/// the 560 ms normal estimate, the sort of a quarter of the points 5 ms, and the estimate stays
-/// within a few percent.
+/// this estimate (its answers are exact for any cell size), and sorting a quarter of the
+/// points instead of all of them for it is a few times cheaper while the estimate stays
+/// within a few percent (`docs/experiments/knn-and-normals.md`).
 pub(crate) fn kth_distance_subsampled(points: &[Point3], quant: &Quantizer, k: usize) -> f64 {
     let n = points.len();
     let mut s = 1usize;
@@ -828,8 +806,7 @@ impl Default for Block {
 
 /// Cell coordinates (each in 0..2^21, as [`CellGrid::cell_of`] gives them) as one integer:
 /// comparing it costs one instruction, where comparing `[i64; 3]` values read back right
-/// after the three stores that wrote them stalled on store forwarding (about 5 % of the
-/// search, measured with perf).
+/// after the three stores that wrote them stalled on store forwarding (seen with perf).
 #[inline]
 fn pack_cell(c: [i64; 3]) -> u64 {
     (c[0] as u64) | ((c[1] as u64) << 21) | ((c[2] as u64) << 42)

@@ -169,9 +169,9 @@ pub fn morton_sorted(points: &[Point3], quantizer: &Quantizer) -> Vec<(u64, u32)
 ///
 /// A stable least-significant-digit radix sort on the cell key alone, which has far fewer bits
 /// than the code at the cell sizes of a neighbour search (8 per axis for 1M points on a cube's
-/// faces: two passes of 12 bits), instead of a comparison sort of the whole 63-bit code.
-/// Measured on 1M cube points in sampling order, 5 runs: 25 to 42 ms for [`morton_sorted`],
-/// 16 to 22 ms for this. Stable, so the result does not depend on how the work is split.
+/// faces: two passes of 12 bits), instead of a comparison sort of the whole 63-bit code
+/// (faster than [`morton_sorted`], see `docs/experiments/knn-and-normals.md`). Stable, so the
+/// result does not depend on how the work is split.
 pub(crate) fn cell_sorted(points: &[Point3], quantizer: &Quantizer, level: u32) -> Vec<(u64, u32)> {
     let shift = 3 * level.min(MORTON_BITS);
     let cell = |c: u64| if shift >= 64 { 0 } else { c >> shift };
