@@ -976,15 +976,9 @@ fn subsample(pts: &[Point3], w: &[f64]) -> (Vec<Point3>, Vec<f64>) {
 /// length²) times squared lever arms (1 for the length parameters, length² for the axis
 /// directions and angles), so the damping, the LM path and the fit are the same in any units.
 ///
-/// The floor was an absolute 1e-12. On a part of unit size it only touched parameters the
-/// cost hardly depends on, but written in units 1000 times larger (a part of millimetres in
-/// metres) the axis entries of a seed of a few dozen vertices fall to 1e-16–1e-15: the floor
-/// then damped the axes thousands of times harder than at unit scale and the fits stopped
-/// elsewhere. Measured on the fillet-chamfer-cone mesh (8778 faces): with noise 0.2 of the
-/// spacing 1881 face labels changed at the exact scale 2^-10 (2342 at 1/1000), with noise 0.1
-/// 141 at 1e-6, without noise 5 at 1e-6; now none at 2^-10 and 1e-6 (at 1/1000 the mesh with
-/// noise 0.2 still changes 385, as round-off does on it: see the module documentation of
-/// [`super`]). Test: `segmentation_is_independent_of_the_mesh_units`.
+/// The floor was an absolute 1e-12, which damped the axes of small seeds thousands of times
+/// harder in units 1000 times larger (`docs/experiments/segmentation.md`). Test:
+/// `segmentation_is_independent_of_the_mesh_units`.
 fn damping_floor<const N: usize>(jtj: &SMatrix<f64, N, N>, scales: &[f64; N]) -> [f64; N] {
     let top = (0..N)
         .map(|j| jtj[(j, j)] * scales[j] * scales[j])
