@@ -18,7 +18,7 @@
 //!   few units across, exp(−d²/400) ≈ 1 and equation 1 is plain PCA, while in micrometres it
 //!   would zero every weight. The default [`PcaWeight::GaussianRelative`]`(2.0)` uses σ = 2 × the
 //!   root-mean-square of the d_j of the neighbourhood (scale invariant). Measured on synthetic
-//!   spheres, planes and cylinders with noise (tests/normals.rs): σ = 1 × the mean distance
+//!   spheres, planes and cylinders with noise (tests/it/normals.rs): σ = 1 × the mean distance
 //!   narrows the effective neighbourhood and raises the median error by ~18 % against plain PCA
 //!   (8.0° vs 6.8° at noise 0.5 spacing) for only ~7 % fewer badly wrong normals next to a
 //!   cube's edges; σ = 2 × the RMS distance costs ≤ 1 %.

@@ -18,7 +18,7 @@
 //! exactly when its sharpness is ≥ 1, and ranking points by it gives ROC curves.
 //!
 //! **Choices where the paper is open** (each measured on the synthetic parts and the PCEDNet
-//! benchmark, see `tests/sharp.rs`):
+//! benchmark, see `tests/it/sharp.rs`):
 //! * N(i) is the point and its k nearest other points (as the PCA normals of
 //!   [`crate::estimate::normals`]). Equation 1's Gaussian weights are available
 //!   ([`SharpParams::pca_weight`], σ = 2 × the neighbourhood's RMS radius instead of σ = k, see
