@@ -18,8 +18,8 @@
 //!   few units across, exp(−d²/400) ≈ 1 and equation 1 is plain PCA, while in micrometres it
 //!   would zero every weight. The default [`PcaWeight::GaussianRelative`]`(2.0)` uses σ = 2 × the
 //!   root-mean-square of the d_j of the neighbourhood (scale invariant): on noisy synthetic
-//!   spheres, planes and cylinders (tests/normals.rs) it costs hardly any accuracy against plain
-//!   PCA, where σ = 1 × the mean distance narrows the neighbourhood too much
+//!   spheres, planes and cylinders (tests/it/normals.rs) it costs hardly any accuracy against
+//!   plain PCA, where σ = 1 × the mean distance narrows the neighbourhood too much
 //!   (`docs/experiments/knn-and-normals.md`).
 //!   [`PcaWeight::GaussianFixed`]`(k as f64)` reproduces the paper literally and [`PcaWeight::Uniform`] is classical PCA (Hoppe 1992).
 //!

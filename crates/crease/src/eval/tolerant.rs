@@ -30,7 +30,7 @@ use crate::{Error, Result};
 /// area 2 or more samples beside the band does not count. Synthetic parts labelled with
 /// `crease synth`'s default (within one expected spacing of a curve, about ±2 average spacings)
 /// have wider bands: on the cube, a detection half as wide as the truth band gets tolerant
-/// recall 0.86 at 2 spacings and 0.99 at 4 (`tests/eval.rs`); pass a larger tolerance there.
+/// recall 0.86 at 2 spacings and 0.99 at 4 (`tests/it/eval.rs`); pass a larger tolerance there.
 pub const DEFAULT_TOLERANCE_SPACINGS: f64 = 2.0;
 
 /// Distance-tolerant scores.

@@ -18,7 +18,7 @@
 //! exactly when its sharpness is ≥ 1, and ranking points by it gives ROC curves.
 //!
 //! **Choices where the paper is open** (each measured on the synthetic parts and the PCEDNet
-//! benchmark, see `tests/sharp.rs`; the figures and the variants tried are in
+//! benchmark, see `tests/it/sharp.rs`; the figures and the variants tried are in
 //! `docs/experiments/sharp-points.md`, `sharp-noise.md` and `sharp-surfaces.md`):
 //! * N(i) is the point and its k nearest other points (as the PCA normals of
 //!   [`crate::estimate::normals`]). Equation 1's Gaussian weights are available

@@ -2,11 +2,9 @@
 //! and AUC = 1, perturbed labels give the exact counts, the ROC CSV is written, and mismatched
 //! inputs fail with a message naming the file.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{crease, json_of};
+use crate::common::{crease, json_of};
 use crease::geometry::Attribute;
 use crease::io::{Geometry, ReadOptions, WriteOptions};
 

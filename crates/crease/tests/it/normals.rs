@@ -491,7 +491,7 @@ fn measure_all() {
 }
 
 /// Timing at 1M points (cube faces, k = 20) in random and Morton-sorted order; run with
-/// `cargo test --release -p crease --test normals timing_1m -- --ignored --nocapture`.
+/// `cargo test --release -p crease --test it normals::timing_1m -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn timing_1m() {

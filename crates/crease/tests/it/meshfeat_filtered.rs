@@ -3,7 +3,7 @@
 //! `meshfeat::tv`), measured against the section 6.1 protocol on the
 //! classic meshes and against exact labels on synthetic parts.
 
-mod common;
+use crate::common;
 
 use crease::eval::roc::roc;
 use crease::eval::Confusion;

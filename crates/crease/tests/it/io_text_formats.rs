@@ -1,7 +1,7 @@
 //! OBJ, OFF, STL and XYZ: round trips, every syntax variant, the shared data files with their
 //! known counts, and the bad-input corpus in `tests/bad_input/`.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

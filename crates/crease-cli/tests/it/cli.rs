@@ -1,11 +1,9 @@
 //! End-to-end tests of the `crease` binary: real data loads, bad input gives clear errors and
 //! the right exit codes, outputs never overwrite inputs, and the commands' outputs are correct.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{crease, json_of};
+use crate::common::{self, crease, json_of};
 
 fn data_dir() -> Option<PathBuf> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");

@@ -2,7 +2,7 @@
 //! the ABC model, scored by area-weighted type accuracy, IoU per true surface and parameter
 //! errors.
 
-mod common;
+use crate::common;
 
 use crease::geometry::SurfaceType;
 use crease::geometry::{face_areas, MeshTopology};

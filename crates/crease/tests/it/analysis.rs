@@ -1,7 +1,7 @@
 //! The shared analysis of a cloud: every stage run from it gives exactly what its one-call form
 //! gives, each piece is computed once, and the results do not depend on the thread count.
 
-mod common;
+use crate::common;
 
 use crease::analysis::{AnalysisParams, CloudAnalysis};
 use crease::fillets::{extract_fillets, extract_fillets_from, FilletParams};

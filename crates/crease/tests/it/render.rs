@@ -1,7 +1,7 @@
 //! PNG quick-looks: pixels where the geometry projects, z-buffer order, colourings, legend,
 //! polylines, the bitmap font, PNG output, bad input.
 
-mod common;
+use crate::common;
 
 use std::collections::HashMap;
 
@@ -762,7 +762,8 @@ fn output_is_deterministic_across_thread_counts() {
     assert_eq!(a.data(), b.data());
 }
 
-/// Writes a sample image for eyeballing: `cargo test -p crease --test render -- --ignored demo`.
+/// Writes a sample image for eyeballing:
+/// `cargo test -p crease --test it -- --ignored render::demo`.
 #[test]
 #[ignore]
 fn demo_image() {
@@ -783,7 +784,7 @@ fn demo_image() {
 }
 
 /// Render times at 100k and 1M points (four views, coloured by a flag, with the cube's
-/// edges): `cargo test --release -p crease --test render -- --ignored timing --nocapture`.
+/// edges): `cargo test --release -p crease --test it -- --ignored render::timing --nocapture`.
 #[test]
 #[ignore]
 fn timing() {
@@ -881,7 +882,7 @@ fn read_pcednet(path: &std::path::Path) -> PointCloud {
 }
 
 /// Sample images from the shared data, for eyeballing:
-/// `cargo test -p crease --test render -- --ignored demo_real`.
+/// `cargo test -p crease --test it -- --ignored render::demo_real`.
 #[test]
 #[ignore]
 fn demo_real_data() {

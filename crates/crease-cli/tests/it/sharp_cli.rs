@@ -1,9 +1,7 @@
 //! End-to-end tests of `crease sharp` and `crease eval`: properties in input order, the
 //! detection scored against the synthetic labels, meshes, the JSON summary, and usage errors.
 
-mod common;
-
-use common::{crease, run, synth};
+use crate::common::{crease, run, synth};
 use crease::io::ReadOptions;
 
 #[test]

@@ -2,7 +2,7 @@
 //! coverage of every fillet border, distance of the lines to the curves, closedness, the
 //! thresholds in the histogram's valleys, and no smooth line where the part has no fillet.
 
-mod common;
+use crate::common;
 
 use crease::fillets::{curve_network, extract_fillets, FilletParams, Fillets};
 use crease::synth::{self, CurveKind, SyntheticPart};

@@ -1,11 +1,9 @@
 //! End-to-end tests of `crease edges` (mesh feature edges, vidal et al. 2011) and of
 //! `crease eval --edges`.
 
-mod common;
-
 use std::path::PathBuf;
 
-use common::{crease, json_of, run, synth};
+use crate::common::{crease, json_of, run, synth};
 use crease::io::ReadOptions;
 
 /// `../shared/data`; fails under `CI=true` when missing, else skips.

@@ -1,7 +1,7 @@
 //! Evaluation against ground truth: every PCEDNet benchmark file's colour classes read and
 //! counted, and a synthetic cube scored against its own (perturbed) labels with exact values.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

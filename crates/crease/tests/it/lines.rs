@@ -1,7 +1,7 @@
 //! Closed sharp feature lines (Demarsin et al. 2007) against the synthetic parts' exact curves:
 //! coverage of every sharp curve, distance of the lines to the curves, closedness.
 
-mod common;
+use crate::common;
 
 use crease::geometry::Point3;
 use crease::lines::{extract_lines, LineNetwork, LinesParams};

@@ -1,9 +1,7 @@
 //! End-to-end tests of `crease curvature`: PLY properties in input order, analytic values on a
 //! synthetic sphere, the Bézier method's sharp flags on a cube mesh, and clear usage errors.
 
-mod common;
-
-use common::{crease, synth};
+use crate::common::{crease, synth};
 use crease::io::ReadOptions;
 
 fn attr(geom: &crease::io::Geometry, name: &str) -> Vec<f64> {

@@ -1,9 +1,7 @@
 //! End-to-end tests of `crease segment`: per-face `surface` / `surface_type` in the input's
 //! face order, the primitives JSON, the render, and usage errors.
 
-mod common;
-
-use common::{crease, json_of, run, synth};
+use crate::common::{crease, json_of, run, synth};
 use crease::io::ReadOptions;
 
 #[test]

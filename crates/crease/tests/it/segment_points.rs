@@ -2,7 +2,7 @@
 //! synthetic parts sampled as clouds with estimated normals, scored against their exact
 //! per-point truth, and the ABC model's vertices as a cloud.
 
-mod common;
+use crate::common;
 
 use crease::geometry::MeshTopology;
 use crease::geometry::SurfaceType;

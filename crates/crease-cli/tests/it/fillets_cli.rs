@@ -2,9 +2,7 @@
 //! with a fillet and a chamfer, the tagged curve network, the per-point labels, and usage
 //! errors.
 
-mod common;
-
-use common::{json_of, run, synth};
+use crate::common::{json_of, run, synth};
 use crease::io::ReadOptions;
 
 #[test]

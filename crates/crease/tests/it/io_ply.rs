@@ -1,7 +1,7 @@
 //! PLY reading and writing: round trips through the three encodings, hand-made big-endian files,
 //! polygons, skipped elements, the real data sets, and the bad-input corpus.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -1,9 +1,7 @@
 //! End-to-end tests of `crease lines`: polylines written as OBJ / PLY, the per-stage JSON
 //! summary (the paper's Table 2), the segmentation output, and usage errors.
 
-mod common;
-
-use common::{crease, run, synth};
+use crate::common::{crease, run, synth};
 use crease::io::ReadOptions;
 
 #[test]

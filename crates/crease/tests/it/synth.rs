@@ -852,7 +852,8 @@ fn mesh_noise_and_open_primitives() {
     );
 }
 
-/// Timing of 1M points per shape: `cargo test --release --test synth -- --ignored --nocapture`.
+/// Timing of 1M points per shape:
+/// `cargo test --release -p crease --test it synth:: -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn timing_one_million_points() {
@@ -1111,7 +1112,7 @@ fn trimmed_meshes_are_closed_over_targets_and_dimensions() {
 }
 
 /// Mesh timings at the default target and at ~1M triangles:
-/// `cargo test --release --test synth timing_meshes -- --ignored --nocapture`.
+/// `cargo test --release -p crease --test it synth::timing_meshes -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn timing_meshes_one_million_triangles() {

@@ -1,6 +1,6 @@
 //! PCD, LAS / LAZ and E57: the real Kinect PCDs, round trips, and the bad-input corpus.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -1,7 +1,7 @@
 //! Mesh feature edges (vidal et al. 2011): the tangent-plane angle estimator, the baselines and
 //! the Potts labelling, measured against exact and protocol ground truth.
 
-mod common;
+use crate::common;
 
 use crease::eval::roc::roc;
 use crease::eval::Confusion;

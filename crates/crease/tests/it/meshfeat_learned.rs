@@ -1,7 +1,7 @@
 //! The learned edge classifier (vidal et al. 2011, sections 4, 5 and 6.3): the feature vector,
 //! the SVM solver and model file, and the learned methods measured against ground truth.
 
-mod common;
+use crate::common;
 
 use crease::eval::roc::roc;
 use crease::eval::Confusion;

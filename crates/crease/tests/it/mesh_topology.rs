@@ -589,7 +589,7 @@ fn cpu_seconds() -> f64 {
 }
 
 /// Times topology and clean-up on ~1M triangles (a grid with shuffled vertex ids).
-/// `cargo test --release -p crease --test mesh_topology -- --ignored --nocapture`
+/// `cargo test --release -p crease --test it mesh_topology:: -- --ignored --nocapture`
 #[test]
 #[ignore]
 fn timing_one_million_triangles() {

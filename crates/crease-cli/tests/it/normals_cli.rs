@@ -1,11 +1,9 @@
 //! End-to-end tests of `crease normals`: PCA and mesh normals written as `nx ny nz` beside the
 //! input's attributes in input order, orientation, the JSON summary, and clear errors.
 
-mod common;
-
 use std::path::Path;
 
-use common::{crease, json_of};
+use crate::common::{crease, json_of};
 use crease::geometry::vec3;
 use crease::io::ReadOptions;
 

@@ -4,7 +4,7 @@
 //!
 //! Thresholds are a little below the measured values (in the comments), so a regression fails.
 
-mod common;
+use crate::common;
 
 use crease::eval::tolerant::{default_tolerance, tolerant_scores};
 use crease::eval::Confusion;
