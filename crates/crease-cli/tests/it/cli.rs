@@ -3,21 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::common::{self, crease, json_of};
-
-fn data_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
-    if d.is_dir() {
-        return Some(d);
-    }
-    assert!(
-        std::env::var("CI").map(|v| v != "true").unwrap_or(true),
-        "CI=true but the shared test data is missing at {}",
-        d.display()
-    );
-    eprintln!("skipping: shared data not found at {}", d.display());
-    None
-}
+use crate::common::{self, crease, data_dir, json_of};
 
 fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
     let mut entries: Vec<_> = std::fs::read_dir(dir)

@@ -4,6 +4,21 @@ use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
 
+/// `../shared/data`; fails under `CI=true` when missing, else skips.
+pub fn data_dir() -> Option<PathBuf> {
+    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
+    if d.is_dir() {
+        return Some(d);
+    }
+    assert!(
+        std::env::var("CI").map(|v| v != "true").unwrap_or(true),
+        "CI=true but the shared test data is missing at {}",
+        d.display()
+    );
+    eprintln!("skipping: shared data not found at {}", d.display());
+    None
+}
+
 /// The `crease` binary built by cargo for this test run.
 pub fn crease() -> Command {
     Command::cargo_bin("crease").expect("the crease binary is built")

@@ -1,25 +1,8 @@
 //! End-to-end tests of `crease edges` (mesh feature edges, vidal et al. 2011) and of
 //! `crease eval --edges`.
 
-use std::path::PathBuf;
-
-use crate::common::{crease, json_of, run, synth};
+use crate::common::{crease, data_dir, json_of, run, synth};
 use crease::io::ReadOptions;
-
-/// `../shared/data`; fails under `CI=true` when missing, else skips.
-fn data_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
-    if d.is_dir() {
-        return Some(d);
-    }
-    assert!(
-        std::env::var("CI").map(|v| v != "true").unwrap_or(true),
-        "CI=true but the shared test data is missing at {}",
-        d.display()
-    );
-    eprintln!("skipping: shared data not found at {}", d.display());
-    None
-}
 
 #[test]
 fn cube_edges_lines_and_edge_element() {
