@@ -83,6 +83,9 @@ pub enum Command {
     /// Segment a triangle mesh into planes, cylinders, cones, spheres and tori with their
     /// parameters (Mizoguchi et al.).
     Segment(crate::commands::segment::SegmentArgs),
+    /// Scan to CAD: the part as a B-rep solid (or an open shell) in a STEP file: analytic faces,
+    /// their intersection curves and vertices.
+    Reconstruct(crate::commands::reconstruct::ReconstructArgs),
     /// Run every capability on a built-in synthetic part; no input files needed.
     Demo {
         /// Folder to write the results into.

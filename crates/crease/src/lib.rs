@@ -12,6 +12,7 @@
 //! Each stage is a plain function: inputs and a `Params` struct in, a result struct out.
 
 pub mod analysis;
+pub mod brep;
 pub mod error;
 pub mod estimate;
 pub mod eval;

@@ -9,6 +9,7 @@ pub(crate) mod fillets;
 mod info;
 pub(crate) mod lines;
 pub(crate) mod normals;
+pub(crate) mod reconstruct;
 mod render;
 pub(crate) mod run;
 pub(crate) mod segment;
@@ -47,6 +48,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Edges(a) => edges::run(g, &a),
         Command::Train(a) => train::run(g, &a),
         Command::Segment(a) => segment::run(g, &a),
+        Command::Reconstruct(a) => reconstruct::run(g, &a),
     }
 }
 

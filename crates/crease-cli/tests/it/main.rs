@@ -12,5 +12,6 @@ mod eval_cli;
 mod fillets_cli;
 mod lines_cli;
 mod normals_cli;
+mod reconstruct_cli;
 mod segment_cli;
 mod sharp_cli;

@@ -7,6 +7,7 @@ mod common;
 
 mod analysis;
 mod architecture;
+mod brep;
 mod curvature;
 mod eval;
 mod fillets;

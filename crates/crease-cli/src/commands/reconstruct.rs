@@ -1,0 +1,139 @@
+//! `crease reconstruct IN -o part.step [--topology topo.json] [--units mm]`: the part as a
+//! boundary representation (B-rep) in a STEP file (`crease::brep`): the mesh segmented into
+//! analytic surfaces, their intersection curves and vertices, a solid when the mesh is closed
+//! and an open shell otherwise.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context;
+use clap::Args;
+use crease::brep::{reconstruct_mesh, to_step, LengthUnit};
+use crease::geometry::TriMesh;
+use crease::segment::SegmentParams;
+
+use crate::args::Global;
+use crate::ui::{usage, Stage};
+
+/// Arguments of `crease reconstruct`.
+#[derive(Args, Debug)]
+pub struct ReconstructArgs {
+    /// Triangle mesh of the part (.ply .obj .off .stl), oriented and 2-manifold.
+    pub input: PathBuf,
+    /// Output STEP file (.step or .stp).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write the B-rep's topology and geometry as JSON: faces with their surface type and
+    /// parameters and loops, edges with their curve and two faces, vertices.
+    #[arg(long, value_name = "JSON")]
+    pub topology: Option<PathBuf>,
+    /// The length unit the coordinates are in, declared in the STEP file (mm, m, in).
+    #[arg(long, default_value = "mm")]
+    pub units: LengthUnit,
+    /// Segmentation: how far a vertex may lie from its surface, in mean edge lengths.
+    #[arg(
+        long = "distance-tolerance",
+        value_name = "EDGES",
+        default_value_t = 0.5
+    )]
+    pub th_pos: f64,
+    /// Segmentation: how far a normal may turn from its surface's, degrees.
+    #[arg(
+        long = "angle-tolerance",
+        value_name = "DEGREES",
+        default_value_t = 8.0
+    )]
+    pub th_norm: f64,
+}
+
+pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
+    let ext = a
+        .output
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if !matches!(ext.as_deref(), Some("step" | "stp")) {
+        return Err(usage(format!(
+            "{}: the output must be a STEP file (.step or .stp)",
+            a.output.display()
+        )));
+    }
+    let mut outputs = vec![&a.output];
+    outputs.extend(a.topology.iter());
+    for o in &outputs {
+        crate::ui::ensure_not_input(o, &[&a.input])?;
+    }
+    let params = SegmentParams {
+        th_pos: a.th_pos,
+        th_norm_degrees: a.th_norm,
+        ..Default::default()
+    };
+    params.validate().map_err(|e| usage(e.to_string()))?;
+    let (mut geom, _) = super::load(g, &a.input)?;
+    if !geom.is_mesh() {
+        anyhow::bail!(
+            "{}: is a point cloud; crease reconstruct builds B-reps from triangle meshes in this \
+             version",
+            a.input.display()
+        );
+    }
+    let mesh = TriMesh {
+        vertices: std::mem::take(&mut geom.points),
+        faces: std::mem::take(&mut geom.faces),
+        face_attributes: std::mem::take(&mut geom.face_attributes),
+    };
+    let start = Instant::now();
+    let stage = Stage::start("B-rep: surfaces, faces, edges, vertices", g.quiet);
+    let rec = reconstruct_mesh(&mesh, &params)
+        .with_context(|| format!("cannot build a B-rep of {}", a.input.display()))?;
+    stage.finish();
+    let name = a
+        .input
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "part".into());
+    // The file's uncertainty: the largest gap the kernel has to close, and never below the
+    // round-off of the coordinates.
+    let size = crease::Aabb::from_points(&mesh.vertices.positions)
+        .map(|b| b.diagonal())
+        .unwrap_or(1.0);
+    let uncertainty = (2.0 * rec.report.max_gap).max(1e-9 * size);
+    let text = to_step(&rec.brep, &name, a.units, uncertainty);
+    crate::ui::write_text(&a.output, &text)
+        .with_context(|| format!("cannot write {}", a.output.display()))?;
+    if let Some(p) = &a.topology {
+        crate::ui::write_text(p, &(serde_json::to_string_pretty(&rec.brep)? + "\n"))
+            .with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    for w in &rec.report.warnings {
+        tracing::warn!("{}: {w}", a.input.display());
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let r = &rec.report;
+    if g.json {
+        crate::ui::print_json(&serde_json::json!({
+            "input": a.input,
+            "output": a.output,
+            "solid": r.closed,
+            "faces": rec.brep.faces.len(),
+            "edges": rec.brep.edges.len(),
+            "report": r,
+            "uncertainty": uncertainty,
+            "seconds": seconds,
+        }))?;
+    } else if !g.quiet {
+        crate::ui::outln(format_args!(
+            "wrote {}: {} with {} faces {:?}, {} edges {:?}, {} vertices; max gap {:.3e}, RMS \
+             mesh distance {:.3e} in {seconds:.2} s",
+            a.output.display(),
+            if r.closed { "a solid" } else { "an open shell" },
+            rec.brep.faces.len(),
+            r.faces_by_type,
+            rec.brep.edges.len(),
+            r.edges_by_curve,
+            r.vertices,
+            r.max_gap,
+            r.rms_distance,
+        ))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,446 @@
+//! Where the faces meet: points on several surfaces at once (the B-rep's vertices, and the
+//! samples of curves without a closed form), and the intersection curve of two adjacent faces,
+//! exact where it is a line or a circle.
+//!
+//! Points: damped Gauss–Newton on the signed distances, started from the mesh vertex. With as
+//! many surfaces as unknowns it converges to their common point; with fewer (two faces and a
+//! closed edge, a face and the mesh border) the damping keeps the step near the minimum-norm
+//! one, so the point stays near its start; with tangent faces (a fillet meeting a plane) the
+//! system is rank deficient and the damping keeps it solvable.
+//!
+//! Curves, in the order tried:
+//! - two planes: their line;
+//! - a plane across the axis of a cylinder, cone, sphere or torus, or two such surfaces on one
+//!   axis (a sphere's centre on the other's axis): the circle about that axis through the
+//!   edge's start vertex;
+//! - a plane parallel to a cylinder's axis: the line along the axis through the start vertex;
+//!   a plane through a torus's axis: the tube circle through the start vertex;
+//! - anything else (an oblique plane through a cylinder, two crossing cylinders): the cubic
+//!   B-spline interpolating the mesh chain's vertices moved onto both surfaces (`interpolate`);
+//! - the mesh border (one surface): the degree-1 B-spline through the chain's vertices moved
+//!   onto the surface (a border may have corners).
+
+use crate::geometry::surface::{signed_distance, surface_normal};
+use crate::geometry::vec3::{add, cross, dist, dot, norm, normalize, scale, sub};
+use crate::geometry::{Point3, SurfaceParams};
+
+use super::Curve;
+
+/// Axes closer to parallel than this (1 − |cos|) are taken as parallel, and points closer
+/// than this fraction of the part's size as on an axis.
+const PARALLEL: f64 = 1e-9;
+
+/// The point nearest `start` (approximately, see the module documentation) on every surface
+/// of `surfaces`.
+pub(crate) fn on_surfaces(surfaces: &[SurfaceParams], start: Point3) -> Point3 {
+    let mut x = start;
+    if surfaces.is_empty() {
+        return x;
+    }
+    for _ in 0..100 {
+        // Normal equations (JᵀJ + μI) δ = −Jᵀr with μ a tiny fraction of the trace.
+        let mut a = [[0.0f64; 3]; 3];
+        let mut b = [0.0f64; 3];
+        let mut cost = 0.0;
+        for s in surfaces {
+            let r = signed_distance(s, x);
+            let g = surface_normal(s, x);
+            cost += r * r;
+            for i in 0..3 {
+                b[i] -= g[i] * r;
+                for j in 0..3 {
+                    a[i][j] += g[i] * g[j];
+                }
+            }
+        }
+        if cost == 0.0 {
+            break;
+        }
+        let mu = 1e-16 * (a[0][0] + a[1][1] + a[2][2]).max(1e-300);
+        for (i, row) in a.iter_mut().enumerate() {
+            row[i] += mu;
+        }
+        let Some(d) = solve3(a, b) else { break };
+        x = add(x, d);
+        if norm(d) <= 1e-15 * (1.0 + norm(x)) {
+            break;
+        }
+    }
+    x
+}
+
+fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<Point3> {
+    let m = nalgebra::Matrix3::from_fn(|i, j| a[i][j]);
+    let v = nalgebra::Vector3::new(b[0], b[1], b[2]);
+    let x = m.lu().solve(&v)?;
+    let x = [x[0], x[1], x[2]];
+    x.iter().all(|c| c.is_finite()).then_some(x)
+}
+
+/// An axis of symmetry of a surface: a point on it and its unit direction (none for a plane;
+/// a sphere's is any line through its centre, returned as `None` direction).
+fn axis(s: &SurfaceParams) -> Option<(Point3, Option<Point3>)> {
+    match *s {
+        SurfaceParams::Plane { .. } => None,
+        SurfaceParams::Cylinder {
+            axis_point,
+            axis_dir,
+            ..
+        } => Some((axis_point, Some(axis_dir))),
+        SurfaceParams::Cone { apex, axis_dir, .. } => Some((apex, Some(axis_dir))),
+        SurfaceParams::Sphere { center, .. } => Some((center, None)),
+        SurfaceParams::Torus {
+            center, axis_dir, ..
+        } => Some((center, Some(axis_dir))),
+    }
+}
+
+fn parallel(a: Point3, b: Point3) -> bool {
+    1.0 - dot(a, b).abs() <= PARALLEL
+}
+
+/// Distance from `p` to the line through `o` along the unit `d`.
+fn to_line(p: Point3, o: Point3, d: Point3) -> f64 {
+    let v = sub(p, o);
+    norm(sub(v, scale(d, dot(v, d))))
+}
+
+/// The circle about the line (`o`, `d`) through `p`.
+fn circle_through(o: Point3, d: Point3, p: Point3) -> Option<Curve> {
+    let centre = add(o, scale(d, dot(sub(p, o), d)));
+    let radius = dist(p, centre);
+    let ref_dir = normalize(sub(p, centre))?;
+    (radius > 0.0).then_some(Curve::Circle {
+        center: centre,
+        axis: d,
+        ref_dir,
+        radius,
+    })
+}
+
+/// The closed-form intersection curve of `a` and `b` through the vertex `start`, if the pair
+/// has one (see the module documentation); `size` scales the "on the axis" test.
+pub(crate) fn analytic_curve(
+    a: &SurfaceParams,
+    b: &SurfaceParams,
+    start: Point3,
+    end: Point3,
+    size: f64,
+) -> Option<Curve> {
+    let on_axis = PARALLEL.sqrt() * size;
+    match (a, b) {
+        (SurfaceParams::Plane { normal: n1, .. }, SurfaceParams::Plane { normal: n2, .. }) => {
+            let d = normalize(cross(*n1, *n2))?;
+            let d = if dot(d, sub(end, start)) < 0.0 {
+                scale(d, -1.0)
+            } else {
+                d
+            };
+            Some(Curve::Line {
+                origin: start,
+                dir: d,
+            })
+        }
+        (SurfaceParams::Plane { normal, .. }, s) | (s, SurfaceParams::Plane { normal, .. }) => {
+            let (o, dir) = axis(s)?;
+            match dir {
+                None => circle_through(o, *normal, start),
+                Some(d) if parallel(d, *normal) => circle_through(o, d, start),
+                Some(d) if dot(d, *normal).abs() <= PARALLEL => match *s {
+                    SurfaceParams::Torus {
+                        center,
+                        major_radius,
+                        minor_radius,
+                        ..
+                    } if dot(sub(center, start), *normal).abs() <= on_axis => {
+                        // A plane through the torus's axis: the two tube circles; the one
+                        // through the start vertex.
+                        let u = normalize(cross(d, *normal))?;
+                        let side = if dot(sub(start, center), u) < 0.0 {
+                            -1.0
+                        } else {
+                            1.0
+                        };
+                        let c = add(center, scale(u, side * major_radius));
+                        let ref_dir = normalize(sub(start, c))?;
+                        Some(Curve::Circle {
+                            center: c,
+                            axis: *normal,
+                            ref_dir,
+                            radius: minor_radius,
+                        })
+                    }
+                    SurfaceParams::Cylinder { .. } => {
+                        let d = if dot(d, sub(end, start)) < 0.0 {
+                            scale(d, -1.0)
+                        } else {
+                            d
+                        };
+                        Some(Curve::Line {
+                            origin: start,
+                            dir: d,
+                        })
+                    }
+                    _ => None,
+                },
+                Some(d)
+                    if matches!(s, SurfaceParams::Cylinder { .. })
+                        && dot(d, *normal).abs() <= PARALLEL =>
+                {
+                    let d = if dot(d, sub(end, start)) < 0.0 {
+                        scale(d, -1.0)
+                    } else {
+                        d
+                    };
+                    Some(Curve::Line {
+                        origin: start,
+                        dir: d,
+                    })
+                }
+                _ => None,
+            }
+        }
+        _ => {
+            let (oa, da) = axis(a)?;
+            let (ob, db) = axis(b)?;
+            match (da, db) {
+                (Some(da), Some(db)) if parallel(da, db) && to_line(ob, oa, da) <= on_axis => {
+                    circle_through(oa, da, start)
+                }
+                (Some(d), None) if to_line(ob, oa, d) <= on_axis => circle_through(oa, d, start),
+                (None, Some(d)) if to_line(oa, ob, d) <= on_axis => circle_through(ob, d, start),
+                _ => None,
+            }
+        }
+    }
+}
+
+/// Points kept of a chain for the interpolating B-spline: enough for a smooth intersection
+/// curve, few enough for the dense solve.
+const MAX_SPLINE_POINTS: usize = 256;
+
+/// The cubic B-spline through `points` (Piegl & Tiller, "The NURBS Book", algorithm A9.1:
+/// chord-length parameters, knots by averaging), after evenly thinning them to at most
+/// [`MAX_SPLINE_POINTS`] (the ends kept). Fewer than four points give a lower degree.
+pub(crate) fn interpolate(points: &[Point3]) -> Curve {
+    let n0 = points.len();
+    let q: Vec<Point3> = if n0 > MAX_SPLINE_POINTS {
+        (0..MAX_SPLINE_POINTS)
+            .map(|i| points[i * (n0 - 1) / (MAX_SPLINE_POINTS - 1)])
+            .collect()
+    } else {
+        points.to_vec()
+    };
+    let n = q.len();
+    if n < 3 {
+        return Curve::polyline(q);
+    }
+    let p = 3.min(n - 1);
+    // Chord-length parameters.
+    let mut u = vec![0.0; n];
+    for k in 1..n {
+        u[k] = u[k - 1] + dist(q[k], q[k - 1]);
+    }
+    let total = u[n - 1];
+    if total <= 0.0 {
+        return Curve::polyline(q);
+    }
+    for x in &mut u {
+        *x /= total;
+    }
+    u[n - 1] = 1.0;
+    // Knots: p + 1 zeros, averages, p + 1 ones.
+    let mut knots = vec![0.0; p + 1];
+    for j in 1..n - p {
+        knots.push(u[j..j + p].iter().sum::<f64>() / p as f64);
+    }
+    knots.extend(std::iter::repeat_n(1.0, p + 1));
+    let a = nalgebra::DMatrix::from_fn(n, n, |k, i| basis(&knots, p, i, u[k]));
+    let Some(lu) = Some(a.lu()) else {
+        return Curve::polyline(q);
+    };
+    let mut control = vec![[0.0; 3]; n];
+    for c in 0..3 {
+        let b = nalgebra::DVector::from_fn(n, |k, _| q[k][c]);
+        let Some(x) = lu.solve(&b) else {
+            return Curve::polyline(q);
+        };
+        for k in 0..n {
+            control[k][c] = x[k];
+        }
+    }
+    if control.iter().flatten().any(|v| !v.is_finite()) {
+        return Curve::polyline(q);
+    }
+    // Distinct knots with multiplicities.
+    let mut distinct: Vec<f64> = Vec::new();
+    let mut mult: Vec<usize> = Vec::new();
+    for &k in &knots {
+        match distinct.last() {
+            Some(&l) if l == k => *mult.last_mut().unwrap_or(&mut 0) += 1,
+            _ => {
+                distinct.push(k);
+                mult.push(1);
+            }
+        }
+    }
+    Curve::BSpline {
+        degree: p,
+        control_points: control,
+        knots: distinct,
+        multiplicities: mult,
+    }
+}
+
+/// The B-spline basis function N_{i,p}(t) on `knots` (Cox–de Boor; the last basis function is
+/// 1 at the end of the domain).
+fn basis(knots: &[f64], p: usize, i: usize, t: f64) -> f64 {
+    let m = knots.len() - 1;
+    if t >= knots[m] {
+        return if i == m - p - 1 { 1.0 } else { 0.0 };
+    }
+    let mut n: Vec<f64> = (0..=p)
+        .map(|j| {
+            if knots[i + j] <= t && t < knots[i + j + 1] {
+                1.0
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    for d in 1..=p {
+        for j in 0..=p - d {
+            let (a0, a1) = (knots[i + j], knots[i + j + d]);
+            let left = if a1 > a0 {
+                (t - a0) / (a1 - a0) * n[j]
+            } else {
+                0.0
+            };
+            let (b0, b1) = (knots[i + j + 1], knots[i + j + d + 1]);
+            let right = if b1 > b0 {
+                (b1 - t) / (b1 - b0) * n[j + 1]
+            } else {
+                0.0
+            };
+            n[j] = left + right;
+        }
+    }
+    n[0]
+}
+
+/// The point of a clamped B-spline at parameter `t` (de Boor by the basis functions).
+pub(crate) fn bspline_point(
+    degree: usize,
+    control: &[Point3],
+    knots: &[f64],
+    multiplicities: &[usize],
+    t: f64,
+) -> Point3 {
+    let full: Vec<f64> = knots
+        .iter()
+        .zip(multiplicities)
+        .flat_map(|(&k, &m)| std::iter::repeat_n(k, m))
+        .collect();
+    let mut p = [0.0; 3];
+    for (i, c) in control.iter().enumerate() {
+        let b = basis(&full, degree, i, t);
+        for k in 0..3 {
+            p[k] += b * c[k];
+        }
+    }
+    p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_interpolating_spline_passes_through_its_points_and_follows_a_circle() {
+        let pts: Vec<Point3> = (0..40)
+            .map(|i| {
+                let a = 2.0 * i as f64 / 39.0;
+                [a.cos(), a.sin(), 0.3]
+            })
+            .collect();
+        let Curve::BSpline {
+            degree,
+            control_points,
+            knots,
+            multiplicities,
+        } = interpolate(&pts)
+        else {
+            panic!("a spline expected");
+        };
+        assert_eq!(degree, 3);
+        assert_eq!(
+            multiplicities.iter().sum::<usize>(),
+            control_points.len() + 4
+        );
+        // Ends exact, and every point of the curve within 1e-6 of the unit circle.
+        let start = bspline_point(degree, &control_points, &knots, &multiplicities, 0.0);
+        let end = bspline_point(degree, &control_points, &knots, &multiplicities, 1.0);
+        assert!(dist(start, pts[0]) < 1e-12 && dist(end, pts[39]) < 1e-12);
+        for i in 0..=200 {
+            let p = bspline_point(
+                degree,
+                &control_points,
+                &knots,
+                &multiplicities,
+                i as f64 / 200.0,
+            );
+            assert!(((p[0].hypot(p[1])) - 1.0).abs() < 1e-6, "{p:?}");
+            assert!((p[2] - 0.3).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn the_common_point_of_three_surfaces_is_solved_exactly() {
+        let planes = [
+            SurfaceParams::Plane {
+                normal: [1.0, 0.0, 0.0],
+                offset: 0.5,
+            },
+            SurfaceParams::Plane {
+                normal: [0.0, 1.0, 0.0],
+                offset: -0.25,
+            },
+        ];
+        let cyl = SurfaceParams::Cylinder {
+            axis_point: [0.0; 3],
+            axis_dir: [1.0, 0.0, 0.0],
+            radius: 1.0,
+        };
+        let p = on_surfaces(&[planes[0], planes[1], cyl], [0.4, -0.2, 0.9]);
+        // x = 0.5, y = -0.25, y² + z² = 1 with z > 0.
+        assert!(
+            dist(p, [0.5, -0.25, (1.0f64 - 0.0625).sqrt()]) < 1e-14,
+            "{p:?}"
+        );
+    }
+
+    #[test]
+    fn a_plane_across_an_axis_meets_it_in_a_circle() {
+        let plane = SurfaceParams::Plane {
+            normal: [0.0, 0.0, 1.0],
+            offset: 2.0,
+        };
+        let cone = SurfaceParams::Cone {
+            apex: [1.0, 1.0, 0.0],
+            axis_dir: [0.0, 0.0, 1.0],
+            half_angle: std::f64::consts::FRAC_PI_4,
+        };
+        let start = [3.0, 1.0, 2.0];
+        let Some(Curve::Circle {
+            center,
+            radius,
+            axis,
+            ..
+        }) = analytic_curve(&plane, &cone, start, start, 10.0)
+        else {
+            panic!("a circle expected");
+        };
+        assert!(dist(center, [1.0, 1.0, 2.0]) < 1e-15 && (radius - 2.0).abs() < 1e-15);
+        assert!(parallel(axis, [0.0, 0.0, 1.0]));
+    }
+}

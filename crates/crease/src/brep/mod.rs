@@ -1,0 +1,711 @@
+//! Scan to CAD: a boundary representation (B-rep) of the part, written as a STEP file.
+//!
+//! From a triangle mesh and its segmentation into analytic surfaces ([`crate::segment`]):
+//! 1. topology (`topology`): faces are the connected regions of triangles on one surface,
+//!    edges the chains of mesh edges between two regions, vertices where three or more meet;
+//! 2. vertices (`intersect::on_surfaces`): solved from the surfaces that meet there, by
+//!    Gauss–Newton from the mesh vertex, not taken from the (noisy) mesh;
+//! 3. edges (`intersect::analytic_curve`): the exact intersection line or circle of the two
+//!    faces' surfaces where the pair has one, otherwise a B-spline through the chain's
+//!    vertices moved onto both surfaces;
+//! 4. faces: the analytic surface, oriented like the mesh (outward on a closed part), bounded
+//!    by the loops of oriented edges;
+//! 5. output ([`step`]): a `MANIFOLD_SOLID_BREP` when every edge has a face on both sides, an
+//!    `OPEN_SHELL` (with a warning naming the border) otherwise.
+//!
+//! Not yet done (issue "scan to CAD"): point clouds, snapping of near relations (parallel
+//! planes, coaxial cylinders, tangent fillets), ellipses and smooth B-splines for the curves
+//! without a closed form.
+
+pub(crate) mod intersect;
+pub mod step;
+pub(crate) mod topology;
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::estimate::noise::{noise_ratio, NOISE_K, NOISY_RATIO};
+use crate::geometry::surface::{signed_distance, surface_normal};
+use crate::geometry::vec3::{cross, dist, dot, norm, sub};
+use crate::geometry::MeshTopology;
+use crate::geometry::{face_areas, face_normals, Aabb, Point3, SurfaceParams, TriMesh};
+use crate::segment::{neighbours_needed, segment_mesh, segment_points, PointParams, SegmentParams};
+use crate::spatial::knn;
+use crate::{Error, Result};
+
+pub use step::{to_step, LengthUnit};
+
+/// The largest gap allowed between a vertex or an edge and a surface it lies on, in mean mesh
+/// edge lengths: beyond it the surfaces do not meet where the mesh's regions do (a surface
+/// missed or mistyped by the segmentation), and the B-rep is refused rather than written
+/// invalid.
+pub const MAX_GAP: f64 = 0.25;
+
+/// The 3D curve of an edge.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Curve {
+    /// The line through `origin` along the unit `dir`.
+    Line {
+        /// A point of the line.
+        origin: Point3,
+        /// Unit direction.
+        dir: Point3,
+    },
+    /// The circle of `radius` about `center` in the plane normal to the unit `axis`; its
+    /// parameter starts at `ref_dir` and turns counter-clockwise about `axis`.
+    Circle {
+        /// Centre.
+        center: Point3,
+        /// Unit normal of the circle's plane.
+        axis: Point3,
+        /// Unit direction from the centre to the parameter origin.
+        ref_dir: Point3,
+        /// Radius.
+        radius: f64,
+    },
+    /// A non-rational B-spline with clamped ends.
+    BSpline {
+        /// Degree.
+        degree: usize,
+        /// Control points.
+        control_points: Vec<Point3>,
+        /// Distinct knot values.
+        knots: Vec<f64>,
+        /// Multiplicity of each knot value.
+        multiplicities: Vec<usize>,
+    },
+}
+
+impl Curve {
+    /// A name for reports: `line`, `circle`, `bspline`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Curve::Line { .. } => "line",
+            Curve::Circle { .. } => "circle",
+            Curve::BSpline { .. } => "bspline",
+        }
+    }
+
+    /// The degree-1 B-spline through `points`.
+    pub fn polyline(points: Vec<Point3>) -> Curve {
+        let n = points.len();
+        let mut multiplicities = vec![1; n];
+        multiplicities[0] = 2;
+        multiplicities[n - 1] = 2;
+        Curve::BSpline {
+            degree: 1,
+            control_points: points,
+            knots: (0..n).map(|i| i as f64).collect(),
+            multiplicities,
+        }
+    }
+
+    /// Points along a B-spline (16 per control point, ends included); none for the analytic
+    /// curves, which lie on their surfaces exactly.
+    pub fn samples(&self) -> Vec<Point3> {
+        match self {
+            Curve::BSpline {
+                degree,
+                control_points,
+                knots,
+                multiplicities,
+            } => {
+                let (a, b) = (knots[0], knots[knots.len() - 1]);
+                let m = 16 * control_points.len();
+                (0..=m)
+                    .map(|i| {
+                        let t = a + (b - a) * i as f64 / m as f64;
+                        intersect::bspline_point(*degree, control_points, knots, multiplicities, t)
+                    })
+                    .collect()
+            }
+            _ => Vec::new(),
+        }
+    }
+
+    /// Distance from `p` to the curve (for a B-spline, to the polygon of its
+    /// [`Curve::samples`]).
+    pub fn distance(&self, p: Point3) -> f64 {
+        match self {
+            Curve::Line { origin, dir } => {
+                let v = sub(p, *origin);
+                norm(cross(v, *dir))
+            }
+            Curve::Circle {
+                center,
+                axis,
+                radius,
+                ..
+            } => {
+                let v = sub(p, *center);
+                let h = dot(v, *axis);
+                let rho = (dot(v, v) - h * h).max(0.0).sqrt();
+                (rho - radius).hypot(h)
+            }
+            Curve::BSpline { .. } => self
+                .samples()
+                .windows(2)
+                .map(|w| segment_distance(p, w[0], w[1]))
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+}
+
+fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
+    let ab = sub(b, a);
+    let l2 = dot(ab, ab);
+    let t = if l2 > 0.0 {
+        (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist(p, [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]])
+}
+
+/// An edge: a curve trimmed by two vertices.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BrepEdge {
+    /// Start vertex.
+    pub start: usize,
+    /// End vertex (equal to `start` for a closed edge).
+    pub end: usize,
+    /// The curve.
+    pub curve: Curve,
+    /// Whether the edge runs along the curve's parameter (false: against it).
+    pub curve_sense: bool,
+    /// The face that walks the edge forwards, and the one that walks it backwards (none on
+    /// the border of an open shell).
+    pub faces: [Option<usize>; 2],
+}
+
+/// A face: an analytic surface bounded by loops of oriented edges.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BrepFace {
+    /// The surface.
+    pub surface: SurfaceParams,
+    /// Index of the segmentation surface it lies on.
+    pub surface_id: usize,
+    /// Whether the surface's normal ([`surface_normal`]) points out of the part.
+    pub same_sense: bool,
+    /// Loops of (edge, walked forwards); the face lies on the left of each, seen from outside.
+    pub loops: Vec<Vec<(usize, bool)>>,
+    /// The outer loop, for planar faces.
+    pub outer: Option<usize>,
+    /// The face's mean surface normal (area-weighted; not unit): where the face lies about an
+    /// axis or a centre, so that a writer can keep the parametrisation's seam and poles off it.
+    pub direction: Point3,
+}
+
+/// A boundary representation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Brep {
+    /// Vertex positions.
+    pub vertices: Vec<Point3>,
+    /// Edges.
+    pub edges: Vec<BrepEdge>,
+    /// Faces.
+    pub faces: Vec<BrepFace>,
+    /// Whether every edge has a face on both sides (a closed shell: a solid).
+    pub closed: bool,
+}
+
+/// What the reconstruction found and how well the B-rep fits the input.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BrepReport {
+    /// The noise ratio measured on the mesh's vertices ([`noise_ratio`]).
+    pub noise_ratio: f64,
+    /// How the surfaces were found: `mesh` (Mizoguchi's mesh path) or `vertices` (the point
+    /// path over the vertices, for a noisy mesh).
+    pub segmentation: &'static str,
+    /// Faces per surface type.
+    pub faces_by_type: BTreeMap<&'static str, usize>,
+    /// Edges per curve type.
+    pub edges_by_curve: BTreeMap<&'static str, usize>,
+    /// Number of vertices.
+    pub vertices: usize,
+    /// A solid (closed shell) or an open shell.
+    pub closed: bool,
+    /// Largest distance of a vertex from one of the surfaces that meet there, and of an
+    /// edge's vertices from its curve: the gap a kernel must close (written as the file's
+    /// uncertainty).
+    pub max_gap: f64,
+    /// RMS distance of the mesh vertices to the surfaces of their faces.
+    pub rms_distance: f64,
+    /// Closed regions cut in two by a plane (whole spheres and tori).
+    pub seams: usize,
+    /// What is missing or approximate, in words.
+    pub warnings: Vec<String>,
+}
+
+/// A B-rep and its report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Reconstruction {
+    /// The boundary representation.
+    pub brep: Brep,
+    /// Counts and residuals.
+    pub report: BrepReport,
+}
+
+/// The B-rep of `mesh`, whose triangle `t` lies on `surfaces[face_surface[t]]` (negative:
+/// unassigned; such triangles join the nearest region). See the module documentation.
+///
+/// Errors (`InvalidInput`): a mesh that is not an oriented 2-manifold, no assigned triangle,
+/// a closed region on a surface that cannot close, borders that do not form loops.
+pub fn brep_from_mesh(
+    mesh: &TriMesh,
+    face_surface: &[i32],
+    surfaces: &[SurfaceParams],
+) -> Result<Reconstruction> {
+    if let Some(&bad) = face_surface
+        .iter()
+        .find(|&&s| s >= 0 && s as usize >= surfaces.len())
+    {
+        return Err(Error::InvalidArgument(format!(
+            "reconstruct: face label {bad} but only {} surfaces",
+            surfaces.len()
+        )));
+    }
+    let mut topo = topology::topology(mesh, face_surface, surfaces)?;
+    let pos = |v: u32| topology::position(mesh, v);
+    let size = Aabb::from_points(&mesh.vertices.positions)
+        .map(|b| b.diagonal())
+        .filter(|d| *d > 0.0)
+        .ok_or_else(|| Error::InvalidInput("reconstruct: the mesh has no extent".into()))?;
+    let nr = topo.surface_of_region.len();
+    let surface_of_region = topo.surface_of_region.clone();
+    let cuts = topo.cuts.clone();
+    let region_surface = |r: u32| -> Option<SurfaceParams> {
+        (r != topology::OUTSIDE).then(|| surfaces[surface_of_region[r as usize]])
+    };
+    // The surfaces an edge lies on: its two regions' (a cut's plane where both are one surface).
+    let edge_surfaces = |l: u32, r: u32| -> Vec<SurfaceParams> {
+        let mut v = Vec::new();
+        if let Some(a) = region_surface(l) {
+            v.push(a);
+        }
+        if r != topology::OUTSIDE {
+            if surface_of_region[l as usize] == surface_of_region[r as usize] {
+                if let Some(&(_, _, plane)) = cuts
+                    .iter()
+                    .find(|c| (c.0 == l && c.1 == r) || (c.0 == r && c.1 == l))
+                {
+                    v.push(plane);
+                }
+            } else if let Some(b) = region_surface(r) {
+                v.push(b);
+            }
+        }
+        v
+    };
+
+    // Vertices from every surface meeting there; then the edges whose two ends coincide (faces
+    // that touch in a point, as a plane touches a fillet's corner ball) are removed and their
+    // ends merged, and the merged vertices solved again.
+    let (mut at_vertex, mut vertices) = solve_vertices(&topo, &edge_surfaces, &pos);
+    let spacing = mean_edge_length(mesh);
+    let tol = 0.1 * spacing;
+    let drop: Vec<bool> = topo
+        .edges
+        .iter()
+        .map(|e| e.start != e.end && dist(vertices[e.start], vertices[e.end]) < tol)
+        .collect();
+    if drop.contains(&true) {
+        topo.collapse_edges(&drop);
+        (at_vertex, vertices) = solve_vertices(&topo, &edge_surfaces, &pos);
+    }
+    let mut max_gap: f64 = 0.0;
+    for (p, surfs) in vertices.iter().zip(&at_vertex) {
+        for s in surfs {
+            max_gap = max_gap.max(signed_distance(s, *p).abs());
+        }
+    }
+
+    // Edges.
+    let mut warnings = Vec::new();
+    let mut border_edges = 0;
+    let mut edges = Vec::with_capacity(topo.edges.len());
+    for e in &topo.edges {
+        let surfs = edge_surfaces(e.left, e.right);
+        let (p0, p1) = (vertices[e.start], vertices[e.end]);
+        let analytic = match surfs.as_slice() {
+            [a, b] => intersect::analytic_curve(a, b, p0, p1, size),
+            _ => None,
+        };
+        let (curve, curve_sense) = match analytic {
+            Some(c @ Curve::Line { .. }) => (c, true),
+            Some(Curve::Circle {
+                center,
+                axis,
+                ref_dir,
+                radius,
+            }) => {
+                let step = sub(pos(e.chain[1]), pos(e.chain[0]));
+                let sense = dot(step::circle_tangent(center, axis, p0), step) >= 0.0;
+                (
+                    Curve::Circle {
+                        center,
+                        axis,
+                        ref_dir,
+                        radius,
+                    },
+                    sense,
+                )
+            }
+            _ => {
+                let n = e.chain.len();
+                let mut pts = Vec::with_capacity(n);
+                pts.push(p0);
+                for &v in &e.chain[1..n - 1] {
+                    pts.push(intersect::on_surfaces(&surfs, pos(v)));
+                }
+                pts.push(p1);
+                if surfs.len() >= 2 {
+                    (spline_on(&surfs, thin_chain(&pts, spacing), spacing), true)
+                } else {
+                    (Curve::polyline(pts), true)
+                }
+            }
+        };
+        max_gap = max_gap.max(curve.distance(p0)).max(curve.distance(p1));
+        // A fitted curve leaves its surfaces between its points.
+        for q in curve.samples() {
+            for sf in &surfs {
+                max_gap = max_gap.max(signed_distance(sf, q).abs());
+            }
+        }
+        if e.right == topology::OUTSIDE {
+            border_edges += 1;
+        }
+        edges.push(BrepEdge {
+            start: e.start,
+            end: e.end,
+            curve,
+            curve_sense,
+            faces: [
+                Some(e.left as usize),
+                (e.right != topology::OUTSIDE).then_some(e.right as usize),
+            ],
+        });
+    }
+    if max_gap > MAX_GAP * spacing {
+        return Err(Error::InvalidInput(format!(
+            "reconstruct: the surfaces found do not meet where the mesh says they do: a vertex or \
+             an edge lies {max_gap:.3e} from a surface it belongs to ({:.2} mesh edges, at most \
+             {MAX_GAP} allowed), so no valid B-rep can be built; the part's surfaces were not \
+             all found (free-form or too noisy?)",
+            max_gap / spacing
+        )));
+    }
+    if border_edges > 0 {
+        warnings.push(format!(
+            "the input has an open border ({border_edges} edges with a face on one side only): \
+             written as an open shell, not a solid"
+        ));
+    }
+
+    // Faces: orientation from the mesh, residuals of the mesh vertices.
+    let normals = face_normals(mesh);
+    let areas = face_areas(mesh);
+    let mut orient = vec![0.0; nr];
+    let mut direction = vec![[0.0; 3]; nr];
+    for (t, f) in mesh.faces.iter().enumerate() {
+        let r = topo.region_of_face[t] as usize;
+        let s = surfaces[topo.surface_of_region[r]];
+        let c = [0, 1, 2].map(|k| (pos(f[0])[k] + pos(f[1])[k] + pos(f[2])[k]) / 3.0);
+        let sn = surface_normal(&s, c);
+        orient[r] += areas[t] * dot(normals[t], sn);
+        for k in 0..3 {
+            direction[r][k] += areas[t] * sn[k];
+        }
+    }
+    let (mut sq, mut count) = (0.0, 0usize);
+    let mut seen = vec![false; mesh.vertices.positions.len()];
+    for (t, f) in mesh.faces.iter().enumerate() {
+        let s = surfaces[topo.surface_of_region[topo.region_of_face[t] as usize]];
+        for &v in f {
+            if !std::mem::replace(&mut seen[v as usize], true) {
+                let d = signed_distance(&s, pos(v));
+                sq += d * d;
+                count += 1;
+            }
+        }
+    }
+    let faces: Vec<BrepFace> = (0..nr)
+        .map(|r| {
+            let surface = surfaces[topo.surface_of_region[r]];
+            let loops = topo.loops[r].clone();
+            let outer = match surface {
+                SurfaceParams::Plane { normal, .. } => loops
+                    .iter()
+                    .enumerate()
+                    .map(|(i, l)| (i, loop_area(l, &edges, &vertices, normal).abs()))
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(i, _)| i),
+                _ => None,
+            };
+            BrepFace {
+                surface,
+                surface_id: topo.surface_of_region[r],
+                same_sense: orient[r] >= 0.0,
+                loops,
+                outer,
+                direction: direction[r],
+            }
+        })
+        .collect();
+    let closed = border_edges == 0;
+    let mut brep = Brep {
+        vertices,
+        edges,
+        faces,
+        closed,
+    };
+    // A closed mesh walked clockwise from outside (negative volume) gives a part inside out.
+    if closed && signed_volume(mesh) < 0.0 {
+        brep.reverse();
+    }
+    let mut faces_by_type = BTreeMap::new();
+    for f in &brep.faces {
+        *faces_by_type.entry(f.surface.kind().name()).or_insert(0) += 1;
+    }
+    let mut edges_by_curve = BTreeMap::new();
+    for e in &brep.edges {
+        *edges_by_curve.entry(e.curve.name()).or_insert(0) += 1;
+    }
+    let report = BrepReport {
+        noise_ratio: 0.0,
+        segmentation: "given",
+        faces_by_type,
+        edges_by_curve,
+        vertices: brep.vertices.len(),
+        closed,
+        max_gap,
+        rms_distance: (sq / count.max(1) as f64).sqrt(),
+        seams: topo.cuts.len(),
+        warnings,
+    };
+    Ok(Reconstruction { brep, report })
+}
+
+/// The B-rep of a triangle mesh: its segmentation into analytic surfaces, then
+/// [`brep_from_mesh`].
+///
+/// The mesh path ([`segment_mesh`]) first. When it leaves more than half of the triangles
+/// unassigned and the vertices are measured noisy ([`noise_ratio`] above [`NOISY_RATIO`]: a
+/// scan's mesh), the mesh is segmented again as a cloud of its vertices ([`segment_points`],
+/// whose tolerances follow the measured noise; the mesh path's Bézier curvature marks most
+/// vertices of such a mesh sharp and finds few seeds), each triangle taking the surface of two
+/// or three of its corners. (The noise measure alone cannot decide: on a coarse CAD mesh the
+/// seven nearest vertices span several faces and read as noise.)
+///
+/// Errors: those of the segmentation and of [`brep_from_mesh`].
+pub fn reconstruct_mesh(mesh: &TriMesh, params: &SegmentParams) -> Result<Reconstruction> {
+    let positions = &mesh.vertices.positions;
+    let topo = MeshTopology::new(mesh)?;
+    let seg = segment_mesh(mesh, &topo, params)?;
+    let assigned = seg.face_surface.iter().filter(|&&s| s >= 0).count();
+    let noise = if positions.len() > neighbours_needed(&PointParams::default(), false) {
+        noise_ratio(positions, &knn(positions, NOISE_K)?)
+    } else {
+        0.0
+    };
+    let (labels, surfaces, how) = if 2 * assigned >= mesh.faces.len() || noise <= NOISY_RATIO {
+        let surfaces: Vec<SurfaceParams> = seg.surfaces.iter().map(|s| s.params).collect();
+        (seg.face_surface, surfaces, "mesh")
+    } else {
+        let seg = segment_points(positions, None, params, &PointParams::default())?;
+        let v = &seg.point_surface;
+        let labels = mesh
+            .faces
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| v[i as usize]);
+                if a == b || a == c {
+                    a
+                } else if b == c {
+                    b
+                } else {
+                    -1
+                }
+            })
+            .collect();
+        let surfaces: Vec<SurfaceParams> = seg.surfaces.iter().map(|s| s.params).collect();
+        (labels, surfaces, "vertices")
+    };
+    let mut rec = brep_from_mesh(mesh, &labels, &surfaces)?;
+    rec.report.noise_ratio = noise;
+    rec.report.segmentation = how;
+    Ok(rec)
+}
+
+/// Per B-rep vertex: the surfaces that meet there (`edge_surfaces` of each incident edge), and
+/// the point on all of them nearest its mesh vertex.
+fn solve_vertices(
+    topo: &topology::Topology,
+    edge_surfaces: &dyn Fn(u32, u32) -> Vec<SurfaceParams>,
+    pos: &dyn Fn(u32) -> Point3,
+) -> (Vec<Vec<SurfaceParams>>, Vec<Point3>) {
+    let mut at_vertex: Vec<Vec<SurfaceParams>> = vec![Vec::new(); topo.vertices.len()];
+    for e in &topo.edges {
+        for s in edge_surfaces(e.left, e.right) {
+            for v in [e.start, e.end] {
+                if !at_vertex[v].contains(&s) {
+                    at_vertex[v].push(s);
+                }
+            }
+        }
+    }
+    let vertices = topo
+        .vertices
+        .iter()
+        .zip(&at_vertex)
+        .map(|(&mv, surfs)| intersect::on_surfaces(surfs, pos(mv)))
+        .collect();
+    (at_vertex, vertices)
+}
+
+/// The points of a chain moved onto a curve, thinned to a monotone sequence: a point is kept
+/// when it lies at least `spacing` from the last one kept and does not turn back on the step
+/// before (the border between two regions of a noisy mesh zigzags about the curve, and its
+/// points projected onto it can step backwards, which an interpolating spline turns into
+/// loops). The ends are kept.
+fn thin_chain(pts: &[Point3], spacing: f64) -> Vec<Point3> {
+    let n = pts.len();
+    if n <= 2 {
+        return pts.to_vec();
+    }
+    let mut kept = vec![pts[0]];
+    let mut step: Option<Point3> = None;
+    for &q in &pts[1..n - 1] {
+        let last = kept[kept.len() - 1];
+        let d = sub(q, last);
+        if norm(d) < spacing || step.is_some_and(|s| dot(s, d) <= 0.0) {
+            continue;
+        }
+        step = Some(d);
+        kept.push(q);
+    }
+    let end = pts[n - 1];
+    // The last kept point too close to the end (or past it) gives way to the end.
+    if kept.len() > 1 && dist(kept[kept.len() - 1], end) < 0.5 * spacing {
+        kept.pop();
+    }
+    kept.push(end);
+    kept
+}
+
+/// The cubic B-spline through `pts` (points on every surface of `surfs`), refined until it
+/// leaves the surfaces by at most 1e-4 `spacing` between its points: each pass adds the
+/// midpoint of every pair of consecutive points, moved onto the surfaces (at most three
+/// passes, and no pass beyond 128 points).
+fn spline_on(surfs: &[SurfaceParams], mut pts: Vec<Point3>, spacing: f64) -> Curve {
+    let mut curve = intersect::interpolate(&pts);
+    for _ in 0..3 {
+        let gap = curve
+            .samples()
+            .iter()
+            .flat_map(|&q| surfs.iter().map(move |s| signed_distance(s, q).abs()))
+            .fold(0.0, f64::max);
+        if gap <= 1e-4 * spacing || pts.len() > 128 {
+            break;
+        }
+        let mut finer = Vec::with_capacity(2 * pts.len());
+        for w in pts.windows(2) {
+            finer.push(w[0]);
+            let mid = [0, 1, 2].map(|k| 0.5 * (w[0][k] + w[1][k]));
+            finer.push(intersect::on_surfaces(surfs, mid));
+        }
+        finer.push(pts[pts.len() - 1]);
+        pts = finer;
+        curve = intersect::interpolate(&pts);
+    }
+    curve
+}
+
+/// Mean length of the mesh's triangle sides.
+fn mean_edge_length(mesh: &TriMesh) -> f64 {
+    let p = &mesh.vertices.positions;
+    let sum: f64 = mesh
+        .faces
+        .iter()
+        .map(|f| {
+            dist(p[f[0] as usize], p[f[1] as usize])
+                + dist(p[f[1] as usize], p[f[2] as usize])
+                + dist(p[f[2] as usize], p[f[0] as usize])
+        })
+        .sum();
+    sum / (3 * mesh.faces.len()).max(1) as f64
+}
+
+/// The volume enclosed by a closed mesh, positive when its triangles turn counter-clockwise
+/// seen from outside.
+fn signed_volume(mesh: &TriMesh) -> f64 {
+    let p = &mesh.vertices.positions;
+    mesh.faces
+        .iter()
+        .map(|f| dot(p[f[0] as usize], cross(p[f[1] as usize], p[f[2] as usize])) / 6.0)
+        .sum()
+}
+
+impl Brep {
+    /// Turns the B-rep inside out: every loop walked the other way, every face's sense
+    /// flipped.
+    pub fn reverse(&mut self) {
+        for f in &mut self.faces {
+            f.same_sense = !f.same_sense;
+            for l in &mut f.loops {
+                l.reverse();
+                for (_, fwd) in l.iter_mut() {
+                    *fwd = !*fwd;
+                }
+            }
+        }
+        for e in &mut self.edges {
+            e.faces.swap(0, 1);
+        }
+    }
+}
+
+/// Signed area of a loop in the plane of normal `n`, from its edges' polylines (vertices and
+/// B-spline control points; circles by their start only, enough to rank loops).
+fn loop_area(l: &[(usize, bool)], edges: &[BrepEdge], vertices: &[Point3], n: Point3) -> f64 {
+    let mut pts: Vec<Point3> = Vec::new();
+    for &(e, fwd) in l {
+        let edge = &edges[e];
+        let mut run: Vec<Point3> = match &edge.curve {
+            Curve::BSpline { control_points, .. } => control_points.clone(),
+            Curve::Circle {
+                center,
+                axis,
+                ref_dir,
+                radius,
+            } if edge.start == edge.end => {
+                // A whole circle: its polygon.
+                let b = cross(*axis, *ref_dir);
+                let s = if edge.curve_sense { 1.0 } else { -1.0 };
+                (0..=32)
+                    .map(|i| {
+                        let a = s * std::f64::consts::TAU * i as f64 / 32.0;
+                        [0, 1, 2]
+                            .map(|k| center[k] + radius * (a.cos() * ref_dir[k] + a.sin() * b[k]))
+                    })
+                    .collect()
+            }
+            _ => vec![vertices[edge.start], vertices[edge.end]],
+        };
+        if !fwd {
+            run.reverse();
+        }
+        pts.extend(run);
+    }
+    let mut a = [0.0; 3];
+    for i in 0..pts.len() {
+        let c = cross(pts[i], pts[(i + 1) % pts.len()]);
+        for k in 0..3 {
+            a[k] += c[k];
+        }
+    }
+    0.5 * dot(a, n)
+}
