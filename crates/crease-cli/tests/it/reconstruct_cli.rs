@@ -280,21 +280,29 @@ fn classic_meshes_that_close_become_valid_solids() {
     }
 }
 
+/// Runs `crease reconstruct INPUT -o OUTPUT`; returns its exit code and stderr.
+fn reconstruct_status(input: &Path, output: &Path) -> (Option<i32>, String) {
+    let out = crease()
+        .arg("reconstruct")
+        .arg(input)
+        .arg("-o")
+        .arg(output)
+        .output()
+        .expect("crease runs");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 #[test]
 fn reconstruct_refuses_what_it_cannot_build() {
     let dir = tempfile::tempdir().expect("temp dir");
     // A point cloud.
     let cloud = synth(dir.path(), &["synth", "cube", "-n", "2000"], "cube.ply");
     let step = dir.path().join("out.step");
-    let out = crease()
-        .arg("reconstruct")
-        .arg(&cloud)
-        .arg("-o")
-        .arg(&step)
-        .output()
-        .expect("runs");
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
+    let (code, err) = reconstruct_status(&cloud, &step);
+    assert_eq!(code, Some(1));
     assert!(
         err.contains("cube.ply") && err.contains("point cloud"),
         "{err}"
@@ -306,14 +314,8 @@ fn reconstruct_refuses_what_it_cannot_build() {
         &["synth", "cube", "--mesh", "-n", "2000"],
         "mesh.ply",
     );
-    let out = crease()
-        .arg("reconstruct")
-        .arg(&mesh)
-        .arg("-o")
-        .arg(dir.path().join("out.ply"))
-        .output()
-        .expect("runs");
-    assert_eq!(out.status.code(), Some(2));
+    let (code, _) = reconstruct_status(&mesh, &dir.path().join("out.ply"));
+    assert_eq!(code, Some(2));
     // A non-manifold mesh: one triangle repeated.
     let bad = dir.path().join("bad.obj");
     std::fs::write(
@@ -321,15 +323,8 @@ fn reconstruct_refuses_what_it_cannot_build() {
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n",
     )
     .expect("write");
-    let out = crease()
-        .arg("reconstruct")
-        .arg(&bad)
-        .arg("-o")
-        .arg(&step)
-        .output()
-        .expect("runs");
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
+    let (code, err) = reconstruct_status(&bad, &step);
+    assert_eq!(code, Some(1));
     assert!(
         err.contains("bad.obj") && err.contains("2-manifold"),
         "{err}"
@@ -396,19 +391,12 @@ fn noisy_meshes_become_valid_solids_within_two_percent_of_the_volume() {
             &format!("{shape}.ply"),
         );
         let step = dir.path().join(format!("{shape}.step"));
-        let out = crease()
-            .arg("reconstruct")
-            .arg(&mesh)
-            .arg("-o")
-            .arg(&step)
-            .output()
-            .expect("runs");
-        if out.status.success() {
+        let (code, err) = reconstruct_status(&mesh, &step);
+        if code == Some(0) {
             let occ = check(&step, None);
             assert_eq!(occ["valid"], true, "{shape}: written, so valid: {occ}");
         } else {
-            assert_eq!(out.status.code(), Some(1));
-            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(code, Some(1), "{shape}: {err}");
             assert!(err.contains("do not meet"), "{shape}: {err}");
             assert!(!step.exists(), "{shape}: no file left behind");
         }

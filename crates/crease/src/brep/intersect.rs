@@ -105,6 +105,16 @@ fn to_line(p: Point3, o: Point3, d: Point3) -> f64 {
     norm(sub(v, scale(d, dot(v, d))))
 }
 
+/// The line through `start` along `±d`, pointing towards `end`.
+fn line_from(start: Point3, end: Point3, d: Point3) -> Curve {
+    let dir = if dot(d, sub(end, start)) < 0.0 {
+        scale(d, -1.0)
+    } else {
+        d
+    };
+    Curve::Line { origin: start, dir }
+}
+
 /// The circle about the line (`o`, `d`) through `p`.
 fn circle_through(o: Point3, d: Point3, p: Point3) -> Option<Curve> {
     let centre = add(o, scale(d, dot(sub(p, o), d)));
@@ -130,16 +140,7 @@ pub(crate) fn analytic_curve(
     let on_axis = PARALLEL.sqrt() * size;
     match (a, b) {
         (SurfaceParams::Plane { normal: n1, .. }, SurfaceParams::Plane { normal: n2, .. }) => {
-            let d = normalize(cross(*n1, *n2))?;
-            let d = if dot(d, sub(end, start)) < 0.0 {
-                scale(d, -1.0)
-            } else {
-                d
-            };
-            Some(Curve::Line {
-                origin: start,
-                dir: d,
-            })
+            Some(line_from(start, end, normalize(cross(*n1, *n2))?))
         }
         (SurfaceParams::Plane { normal, .. }, s) | (s, SurfaceParams::Plane { normal, .. }) => {
             let (o, dir) = axis(s)?;
@@ -170,33 +171,9 @@ pub(crate) fn analytic_curve(
                             radius: minor_radius,
                         })
                     }
-                    SurfaceParams::Cylinder { .. } => {
-                        let d = if dot(d, sub(end, start)) < 0.0 {
-                            scale(d, -1.0)
-                        } else {
-                            d
-                        };
-                        Some(Curve::Line {
-                            origin: start,
-                            dir: d,
-                        })
-                    }
+                    SurfaceParams::Cylinder { .. } => Some(line_from(start, end, d)),
                     _ => None,
                 },
-                Some(d)
-                    if matches!(s, SurfaceParams::Cylinder { .. })
-                        && dot(d, *normal).abs() <= PARALLEL =>
-                {
-                    let d = if dot(d, sub(end, start)) < 0.0 {
-                        scale(d, -1.0)
-                    } else {
-                        d
-                    };
-                    Some(Curve::Line {
-                        origin: start,
-                        dir: d,
-                    })
-                }
                 _ => None,
             }
         }
