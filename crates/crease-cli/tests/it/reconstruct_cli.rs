@@ -375,6 +375,21 @@ fn noisy_meshes_become_valid_solids_within_two_percent_of_the_volume() {
         let step = dir.path().join(format!("{shape}.step"));
         let summary = reconstruct(&mesh, &step);
         assert_eq!(summary["report"]["segmentation"], "vertices", "{shape}");
+        // The noisy fits' near relations are made exact, so the holes and ends meet their
+        // planes in circles (snaps reported, each a fraction of a few degrees).
+        let circles = summary["report"]["edges_by_curve"]["circle"].as_u64().unwrap_or(0);
+        let want = match shape {
+            "box-hole" => 2,
+            "two-cylinders" => 4,
+            "sphere" => 1,
+            "torus" => 2,
+            _ => 0,
+        };
+        assert_eq!(circles, want, "{shape}: {summary}");
+        for snap in summary["report"]["snaps"].as_array().expect("snaps") {
+            let off = snap["off_by"].as_f64().expect("off_by");
+            assert!(off > 0.0 && off < 5.0, "{shape}: {snap}");
+        }
         let occ = check(&step, None);
         assert_eq!(occ["valid"], true, "{shape}: {occ}");
         assert_eq!(occ["solids"], 1, "{shape}: {occ}");

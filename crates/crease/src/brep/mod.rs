@@ -18,6 +18,7 @@
 //! without a closed form.
 
 pub(crate) mod intersect;
+pub mod snap;
 pub mod step;
 pub(crate) mod topology;
 
@@ -40,7 +41,7 @@ pub use step::{to_step, LengthUnit};
 /// edge lengths: beyond it the surfaces do not meet where the mesh's regions do (a surface
 /// missed or mistyped by the segmentation), and the B-rep is refused rather than written
 /// invalid.
-pub const MAX_GAP: f64 = 0.25;
+pub const MAX_GAP: f64 = 0.1;
 
 /// The 3D curve of an edge.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -196,6 +197,8 @@ pub struct BrepFace {
     /// The face's mean surface normal (area-weighted; not unit): where the face lies about an
     /// axis or a centre, so that a writer can keep the parametrisation's seam and poles off it.
     pub direction: Point3,
+    /// RMS distance of the face's mesh vertices (counted once per triangle) to its surface.
+    pub rms: f64,
 }
 
 /// A boundary representation.
@@ -235,6 +238,8 @@ pub struct BrepReport {
     pub rms_distance: f64,
     /// Closed regions cut in two by a plane (whole spheres and tori).
     pub seams: usize,
+    /// Relations made exact before building (`snap`).
+    pub snaps: Vec<snap::Snap>,
     /// What is missing or approximate, in words.
     pub warnings: Vec<String>,
 }
@@ -274,6 +279,9 @@ pub fn brep_from_mesh(
         .filter(|d| *d > 0.0)
         .ok_or_else(|| Error::InvalidInput("reconstruct: the mesh has no extent".into()))?;
     let nr = topo.surface_of_region.len();
+    // Relations within the noise made exact (module `snap`).
+    let (surfaces, snaps) = snap_surfaces(mesh, &topo, surfaces, size);
+    let surfaces = &surfaces[..];
     let surface_of_region = topo.surface_of_region.clone();
     let cuts = topo.cuts.clone();
     let region_surface = |r: u32| -> Option<SurfaceParams> {
@@ -421,12 +429,16 @@ pub fn brep_from_mesh(
         }
     }
     let (mut sq, mut count) = (0.0, 0usize);
+    let (mut face_sq, mut face_count) = (vec![0.0; nr], vec![0usize; nr]);
     let mut seen = vec![false; mesh.vertices.positions.len()];
     for (t, f) in mesh.faces.iter().enumerate() {
-        let s = surfaces[topo.surface_of_region[topo.region_of_face[t] as usize]];
+        let r = topo.region_of_face[t] as usize;
+        let s = surfaces[topo.surface_of_region[r]];
         for &v in f {
+            let d = signed_distance(&s, pos(v));
+            face_sq[r] += d * d;
+            face_count[r] += 1;
             if !std::mem::replace(&mut seen[v as usize], true) {
-                let d = signed_distance(&s, pos(v));
                 sq += d * d;
                 count += 1;
             }
@@ -452,6 +464,7 @@ pub fn brep_from_mesh(
                 loops,
                 outer,
                 direction: direction[r],
+                rms: (face_sq[r] / face_count[r].max(1) as f64).sqrt(),
             }
         })
         .collect();
@@ -484,6 +497,7 @@ pub fn brep_from_mesh(
         max_gap,
         rms_distance: (sq / count.max(1) as f64).sqrt(),
         seams: topo.cuts.len(),
+        snaps,
         warnings,
     };
     Ok(Reconstruction { brep, report })
@@ -538,6 +552,69 @@ pub fn reconstruct_mesh(mesh: &TriMesh, params: &SegmentParams) -> Result<Recons
     rec.report.noise_ratio = noise;
     rec.report.segmentation = how;
     Ok(rec)
+}
+
+/// `surfaces` with the relations the mesh cannot tell from exact ones made exact (see
+/// `snap`), and what was snapped.
+fn snap_surfaces(
+    mesh: &TriMesh,
+    topo: &topology::Topology,
+    surfaces: &[SurfaceParams],
+    size: f64,
+) -> (Vec<SurfaceParams>, Vec<snap::Snap>) {
+    let ns = surfaces.len();
+    let p = &mesh.vertices.positions;
+    let areas = face_areas(mesh);
+    let (mut sq, mut count, mut area) = (vec![0.0; ns], vec![0usize; ns], vec![0.0; ns]);
+    let mut sum = vec![[0.0; 3]; ns];
+    let mut boxes: Vec<Option<Aabb>> = vec![None; ns];
+    for (t, f) in mesh.faces.iter().enumerate() {
+        let s = topo.surface_of_region[topo.region_of_face[t] as usize];
+        area[s] += areas[t];
+        for &v in f {
+            let q = p[v as usize];
+            let d = signed_distance(&surfaces[s], q);
+            sq[s] += d * d;
+            count[s] += 1;
+            for k in 0..3 {
+                sum[s][k] += q[k];
+            }
+            boxes[s] = Some(match boxes[s] {
+                Some(mut b) => {
+                    b.grow(q);
+                    b
+                }
+                None => Aabb { min: q, max: q },
+            });
+        }
+    }
+    let stats: Vec<snap::FaceStats> = (0..ns)
+        .map(|s| {
+            let c = count[s].max(1) as f64;
+            snap::FaceStats {
+                rms: (sq[s] / c).sqrt(),
+                extent: boxes[s].map(|b| b.diagonal()).unwrap_or(0.0),
+                area: area[s],
+                centroid: sum[s].map(|x| x / c),
+            }
+        })
+        .collect();
+    let mut adjacent: Vec<(usize, usize)> = topo
+        .edges
+        .iter()
+        .filter(|e| e.right != topology::OUTSIDE)
+        .map(|e| {
+            let a = topo.surface_of_region[e.left as usize];
+            let b = topo.surface_of_region[e.right as usize];
+            (a.min(b), a.max(b))
+        })
+        .filter(|(a, b)| a != b)
+        .collect();
+    adjacent.sort_unstable();
+    adjacent.dedup();
+    let mut snapped = surfaces.to_vec();
+    let snaps = snap::snap(&mut snapped, &adjacent, &stats, size);
+    (snapped, snaps)
 }
 
 /// Per B-rep vertex: the surfaces that meet there (`edge_surfaces` of each incident edge), and

@@ -1,0 +1,354 @@
+//! Snapping: relations the data cannot tell from exact ones made exact before the B-rep is
+//! built, within the measured noise, each one reported.
+//!
+//! A noisy fit leaves a hole's axis a degree off its plate's normal; the B-rep would then meet
+//! the plate in an ellipse-like B-spline where the designer drew a circle, and the kernel sees
+//! a slanted hole. For every pair of adjacent faces:
+//! - a surface of revolution (cylinder, cone, torus) and a plane whose normal is within the
+//!   angle tolerance of its axis: the axis is made the normal (the circle of a hole in a plate,
+//!   of a boss's top);
+//! - a cylinder whose axis is within the tolerance of lying in an adjacent plane's direction:
+//!   the axis is made parallel to the plane (the lines where a fillet or a slot meets a face);
+//! - two surfaces of revolution with axes within the angle tolerance of each other and within
+//!   the distance tolerance of each other where they meet (or a sphere whose centre is that
+//!   close to the axis): both put on one axis, the larger face's (a stepped shaft, a fillet
+//!   between coaxial cylinders, a ball end).
+//!
+//! Before those, across the whole part: a plane whose normal is within the angle tolerance of a
+//! larger plane's is made parallel to it, and one within the tolerance of perpendicular to
+//! larger ones is made perpendicular to them (its offset refitted to its vertices).
+//!
+//! Tolerances from the data: the distance tolerance is three times the larger RMS residual of
+//! the two faces' mesh vertices (and at least 1e-9 of the part's size), the angle tolerance
+//! that distance over the smaller face's extent (the tilt a fit of that face cannot resolve).
+//! Planes never move: their normals are the best-determined directions of a part. The rules
+//! are applied in order, each surface snapped at most once per rule, larger faces first.
+
+use serde::Serialize;
+
+use crate::geometry::vec3::{add, dist, dot, norm, normalize, scale, sub};
+use crate::geometry::{Point3, SurfaceParams};
+
+/// One relation made exact.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Snap {
+    /// What was made exact, in words.
+    pub relation: String,
+    /// The surface that moved (index into the segmentation's surfaces).
+    pub surface: usize,
+    /// The surface it was snapped to.
+    pub to: usize,
+    /// How far it was off: an angle in degrees, or a distance.
+    pub off_by: f64,
+}
+
+/// What a face tells about the precision of its surface.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FaceStats {
+    /// RMS distance of the face's mesh vertices to the surface.
+    pub rms: f64,
+    /// Largest distance between two of its vertices (approximately: the bounding-box diagonal).
+    pub extent: f64,
+    /// Area of the face.
+    pub area: f64,
+    /// Centroid of the face's vertices.
+    pub centroid: Point3,
+}
+
+fn axis_of(s: &SurfaceParams) -> Option<(Point3, Point3)> {
+    match *s {
+        SurfaceParams::Cylinder {
+            axis_point,
+            axis_dir,
+            ..
+        } => Some((axis_point, axis_dir)),
+        SurfaceParams::Cone { apex, axis_dir, .. } => Some((apex, axis_dir)),
+        SurfaceParams::Torus {
+            center, axis_dir, ..
+        } => Some((center, axis_dir)),
+        _ => None,
+    }
+}
+
+/// The surface with its axis moved to the line (`o`, `d`) (`d` unit, turned to agree with the
+/// old axis's direction); the axis point is the old one's foot on the new line, so the surface
+/// stays where its data is.
+fn with_axis(s: &SurfaceParams, o: Point3, d: Point3) -> SurfaceParams {
+    let Some((p, old)) = axis_of(s) else {
+        return *s;
+    };
+    let d = if dot(d, old) < 0.0 { scale(d, -1.0) } else { d };
+    let foot = add(o, scale(d, dot(sub(p, o), d)));
+    match *s {
+        SurfaceParams::Cylinder { radius, .. } => SurfaceParams::Cylinder {
+            axis_point: foot,
+            axis_dir: d,
+            radius,
+        },
+        SurfaceParams::Cone { half_angle, .. } => SurfaceParams::Cone {
+            apex: foot,
+            axis_dir: d,
+            half_angle,
+        },
+        SurfaceParams::Torus {
+            major_radius,
+            minor_radius,
+            ..
+        } => SurfaceParams::Torus {
+            center: foot,
+            axis_dir: d,
+            major_radius,
+            minor_radius,
+        },
+        other => other,
+    }
+}
+
+/// Distance from `p` to the line (`o`, unit `d`).
+fn to_line(p: Point3, o: Point3, d: Point3) -> f64 {
+    let v = sub(p, o);
+    norm(sub(v, scale(d, dot(v, d))))
+}
+
+fn degrees(cos: f64) -> f64 {
+    cos.abs().min(1.0).acos().to_degrees()
+}
+
+/// Snaps `surfaces` (see the module documentation) given the adjacent pairs and each surface's
+/// face statistics; returns what was snapped.
+pub(crate) fn snap(
+    surfaces: &mut [SurfaceParams],
+    adjacent: &[(usize, usize)],
+    stats: &[FaceStats],
+    size: f64,
+) -> Vec<Snap> {
+    let mut snaps = Vec::new();
+    let tolerances = |a: usize, b: usize| {
+        let d = (3.0 * stats[a].rms.max(stats[b].rms)).max(1e-9 * size);
+        let extent = stats[a].extent.min(stats[b].extent).max(1e-300);
+        (d, d / extent)
+    };
+    // Larger faces first.
+    let mut pairs: Vec<(usize, usize)> = adjacent.to_vec();
+    pairs.sort_by(|x, y| {
+        let ax = stats[x.0].area.max(stats[x.1].area);
+        let ay = stats[y.0].area.max(stats[y.1].area);
+        ay.total_cmp(&ax).then(x.cmp(y))
+    });
+    // 0: planes made parallel to a larger plane whose normal is within the tolerance, or
+    // perpendicular to the larger ones they nearly are perpendicular to.
+    let mut planes: Vec<usize> = (0..surfaces.len())
+        .filter(|&i| matches!(surfaces[i], SurfaceParams::Plane { .. }))
+        .collect();
+    planes.sort_by(|&x, &y| stats[y].area.total_cmp(&stats[x].area).then(x.cmp(&y)));
+    let mut directions: Vec<(Point3, usize)> = Vec::new();
+    for &i in &planes {
+        let SurfaceParams::Plane { normal, .. } = surfaces[i] else {
+            continue;
+        };
+        let parallel = directions.iter().find(|&&(d, src)| {
+            let off = degrees(dot(normal, d));
+            off.to_radians() <= tolerances(i, src).1
+        });
+        let new = if let Some(&(d, src)) = parallel {
+            let off = degrees(dot(normal, d));
+            let d = if dot(normal, d) < 0.0 {
+                scale(d, -1.0)
+            } else {
+                d
+            };
+            if off > 0.0 {
+                snaps.push(Snap {
+                    relation: format!("plane parallel to plane {src}"),
+                    surface: i,
+                    to: src,
+                    off_by: off,
+                });
+            }
+            d
+        } else {
+            let mut n = normal;
+            for &(d, src) in &directions {
+                let off = 90.0 - degrees(dot(n, d));
+                if off > 0.0 && off.to_radians() <= tolerances(i, src).1 {
+                    if let Some(m) = normalize(sub(n, scale(d, dot(n, d)))) {
+                        n = m;
+                        snaps.push(Snap {
+                            relation: format!("plane perpendicular to plane {src}"),
+                            surface: i,
+                            to: src,
+                            off_by: off,
+                        });
+                    }
+                }
+            }
+            directions.push((n, i));
+            n
+        };
+        if new != normal {
+            surfaces[i] = SurfaceParams::Plane {
+                normal: new,
+                offset: dot(new, stats[i].centroid),
+            };
+        }
+    }
+    // 1 and 2: axes against planes.
+    let mut moved = vec![false; surfaces.len()];
+    for &(a, b) in &pairs {
+        for (p, s) in [(a, b), (b, a)] {
+            let SurfaceParams::Plane { normal, .. } = surfaces[p] else {
+                continue;
+            };
+            let Some((o, d)) = axis_of(&surfaces[s]) else {
+                continue;
+            };
+            if moved[s] {
+                continue;
+            }
+            let (_, angle) = tolerances(p, s);
+            let c = dot(d, normal);
+            let off_parallel = degrees(c);
+            let off_perpendicular = 90.0 - off_parallel;
+            if off_parallel > 0.0 && off_parallel.to_radians() <= angle {
+                surfaces[s] = with_axis(&surfaces[s], o, normal);
+                moved[s] = true;
+                snaps.push(Snap {
+                    relation: format!(
+                        "{} axis along the normal of plane {p}",
+                        surfaces[s].kind().name()
+                    ),
+                    surface: s,
+                    to: p,
+                    off_by: off_parallel,
+                });
+            } else if matches!(surfaces[s], SurfaceParams::Cylinder { .. })
+                && off_perpendicular > 0.0
+                && off_perpendicular.to_radians() <= angle
+            {
+                if let Some(nd) = normalize(sub(d, scale(normal, c))) {
+                    surfaces[s] = with_axis(&surfaces[s], o, nd);
+                    moved[s] = true;
+                    snaps.push(Snap {
+                        relation: format!("cylinder axis parallel to plane {p}"),
+                        surface: s,
+                        to: p,
+                        off_by: off_perpendicular,
+                    });
+                }
+            }
+        }
+    }
+    // 3: coaxial surfaces of revolution (the larger face's axis kept).
+    let mut moved = vec![false; surfaces.len()];
+    for &(a, b) in &pairs {
+        let (big, small) = if stats[a].area >= stats[b].area {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        if moved[small] || moved[big] {
+            continue;
+        }
+        let (dtol, atol) = tolerances(big, small);
+        match (axis_of(&surfaces[big]), surfaces[small]) {
+            (Some((o, d)), SurfaceParams::Sphere { center, radius }) => {
+                let off = to_line(center, o, d);
+                if off > 0.0 && off <= dtol {
+                    let foot = add(o, scale(d, dot(sub(center, o), d)));
+                    surfaces[small] = SurfaceParams::Sphere {
+                        center: foot,
+                        radius,
+                    };
+                    moved[small] = true;
+                    snaps.push(Snap {
+                        relation: format!("sphere centre on the axis of surface {big}"),
+                        surface: small,
+                        to: big,
+                        off_by: off,
+                    });
+                }
+            }
+            (Some((o, d)), s) => {
+                let Some((os, ds)) = axis_of(&s) else {
+                    continue;
+                };
+                let off_angle = degrees(dot(d, ds));
+                // Distance between the axes where the two faces meet.
+                let m = scale(add(stats[big].centroid, stats[small].centroid), 0.5);
+                let foot = |o: Point3, d: Point3| add(o, scale(d, dot(sub(m, o), d)));
+                let off = dist(foot(o, d), foot(os, ds));
+                let parallel = off_angle.to_radians() <= atol;
+                if parallel && off <= dtol && (off_angle > 0.0 || off > 0.0) {
+                    surfaces[small] = with_axis(&s, o, d);
+                    moved[small] = true;
+                    snaps.push(Snap {
+                        relation: format!("{} coaxial with surface {big}", s.kind().name()),
+                        surface: small,
+                        to: big,
+                        off_by: off_angle.max(off),
+                    });
+                }
+            }
+            _ => {}
+        }
+    }
+    // Keep unit axes exact after the arithmetic.
+    for s in surfaces.iter_mut() {
+        if let Some((o, d)) = axis_of(s) {
+            if let Some(u) = normalize(d) {
+                *s = with_axis(s, o, u);
+            }
+        }
+    }
+    snaps
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stats(rms: f64, extent: f64, area: f64, centroid: Point3) -> FaceStats {
+        FaceStats {
+            rms,
+            extent,
+            area,
+            centroid,
+        }
+    }
+
+    #[test]
+    fn a_slightly_tilted_hole_is_made_square_to_its_plate_and_an_exact_one_is_left() {
+        let plate = SurfaceParams::Plane {
+            normal: [0.0, 0.0, 1.0],
+            offset: 0.5,
+        };
+        let tilt = 0.01f64; // 0.57°
+        let hole = SurfaceParams::Cylinder {
+            axis_point: [0.2, 0.1, 0.0],
+            axis_dir: [tilt.sin(), 0.0, tilt.cos()],
+            radius: 0.1,
+        };
+        let st = [
+            stats(0.005, 1.0, 1.0, [0.0, 0.0, 0.5]),
+            stats(0.005, 0.5, 0.2, [0.2, 0.1, 0.2]),
+        ];
+        let mut s = [plate, hole];
+        let snaps = snap(&mut s, &[(0, 1)], &st, 1.0);
+        assert_eq!(snaps.len(), 1, "{snaps:?}");
+        assert!((snaps[0].off_by - tilt.to_degrees()).abs() < 1e-9);
+        let SurfaceParams::Cylinder { axis_dir, .. } = s[1] else {
+            panic!()
+        };
+        assert_eq!(axis_dir, [0.0, 0.0, 1.0]);
+        // 3 × 0.005 over 0.5: 1.7°; a tilt of 3° stays.
+        let mut s = [
+            plate,
+            SurfaceParams::Cylinder {
+                axis_point: [0.2, 0.1, 0.0],
+                axis_dir: [0.05f64.sin(), 0.0, 0.05f64.cos()],
+                radius: 0.1,
+            },
+        ];
+        assert!(snap(&mut s, &[(0, 1)], &st, 1.0).is_empty());
+    }
+}
