@@ -377,7 +377,9 @@ fn noisy_meshes_become_valid_solids_within_two_percent_of_the_volume() {
         assert_eq!(summary["report"]["segmentation"], "vertices", "{shape}");
         // The noisy fits' near relations are made exact, so the holes and ends meet their
         // planes in circles (snaps reported, each a fraction of a few degrees).
-        let circles = summary["report"]["edges_by_curve"]["circle"].as_u64().unwrap_or(0);
+        let circles = summary["report"]["edges_by_curve"]["circle"]
+            .as_u64()
+            .unwrap_or(0);
         let want = match shape {
             "box-hole" => 2,
             "two-cylinders" => 4,

@@ -28,7 +28,7 @@ use serde::Serialize;
 
 use crate::estimate::noise::{noise_ratio, NOISE_K, NOISY_RATIO};
 use crate::geometry::surface::{signed_distance, surface_normal};
-use crate::geometry::vec3::{cross, dist, dot, norm, sub};
+use crate::geometry::vec3::{cross, dist, dot, norm, normalize, sub};
 use crate::geometry::MeshTopology;
 use crate::geometry::{face_areas, face_normals, Aabb, Point3, SurfaceParams, TriMesh};
 use crate::segment::{neighbours_needed, segment_mesh, segment_points, PointParams, SegmentParams};
@@ -197,6 +197,10 @@ pub struct BrepFace {
     /// The face's mean surface normal (area-weighted; not unit): where the face lies about an
     /// axis or a centre, so that a writer can keep the parametrisation's seam and poles off it.
     pub direction: Point3,
+    /// For a cylinder, cone or torus: where to put the parametrisation's seam (a unit
+    /// direction from the axis), in the widest angle around the axis that the face's
+    /// boundary does not cross; none when every edge goes all the way round.
+    pub seam: Option<Point3>,
     /// RMS distance of the face's mesh vertices (counted once per triangle) to its surface.
     pub rms: f64,
 }
@@ -323,10 +327,31 @@ pub fn brep_from_mesh(
         topo.collapse_edges(&drop);
         (at_vertex, vertices) = solve_vertices(&topo, &edge_surfaces, &pos);
     }
+    // The largest gap, and where: a point and the surfaces that should meet there.
     let mut max_gap: f64 = 0.0;
-    for (p, surfs) in vertices.iter().zip(&at_vertex) {
+    let mut worst = String::new();
+    let mut note = |gap: f64, at: Point3, surfs: &[SurfaceParams], max_gap: &mut f64| {
+        if gap > *max_gap {
+            *max_gap = gap;
+            let kinds: Vec<&str> = surfs.iter().map(|s| s.kind().name()).collect();
+            worst = format!(
+                "near ({:.4}, {:.4}, {:.4}), where the {} meet",
+                at[0],
+                at[1],
+                at[2],
+                kinds.join(", ")
+            );
+        }
+    };
+    for (v, (p, surfs)) in vertices.iter().zip(&at_vertex).enumerate() {
         for s in surfs {
-            max_gap = max_gap.max(signed_distance(s, *p).abs());
+            let mesh_vertex = pos(topo.vertices[v]);
+            note(
+                signed_distance(s, *p).abs(),
+                mesh_vertex,
+                surfs,
+                &mut max_gap,
+            );
         }
     }
 
@@ -376,11 +401,12 @@ pub fn brep_from_mesh(
                 }
             }
         };
-        max_gap = max_gap.max(curve.distance(p0)).max(curve.distance(p1));
+        note(curve.distance(p0), p0, &surfs, &mut max_gap);
+        note(curve.distance(p1), p1, &surfs, &mut max_gap);
         // A fitted curve leaves its surfaces between its points.
         for q in curve.samples() {
             for sf in &surfs {
-                max_gap = max_gap.max(signed_distance(sf, q).abs());
+                note(signed_distance(sf, q).abs(), q, &surfs, &mut max_gap);
             }
         }
         if e.right == topology::OUTSIDE {
@@ -399,8 +425,8 @@ pub fn brep_from_mesh(
     }
     if max_gap > MAX_GAP * spacing {
         return Err(Error::InvalidInput(format!(
-            "reconstruct: the surfaces found do not meet where the mesh says they do: a vertex or \
-             an edge lies {max_gap:.3e} from a surface it belongs to ({:.2} mesh edges, at most \
+            "reconstruct: the surfaces found do not meet where the mesh says they do: {worst}, \
+             a vertex or an edge lies {max_gap:.3e} from one of them ({:.2} mesh edges, at most \
              {MAX_GAP} allowed), so no valid B-rep can be built; the part's surfaces were not \
              all found (free-form or too noisy?)",
             max_gap / spacing
@@ -464,6 +490,7 @@ pub fn brep_from_mesh(
                 loops,
                 outer,
                 direction: direction[r],
+                seam: seam_direction(&surface, &topo.loops[r], &edges, &vertices),
                 rms: (face_sq[r] / face_count[r].max(1) as f64).sqrt(),
             }
         })
@@ -529,6 +556,8 @@ pub fn reconstruct_mesh(mesh: &TriMesh, params: &SegmentParams) -> Result<Recons
         let surfaces: Vec<SurfaceParams> = seg.surfaces.iter().map(|s| s.params).collect();
         (seg.face_surface, surfaces, "mesh")
     } else {
+        // PCA normals over 20 neighbours: the noisy mesh's own vertex normals (its one-ring)
+        // average too few points.
         let seg = segment_points(positions, None, params, &PointParams::default())?;
         let v = &seg.point_surface;
         let labels = mesh
@@ -548,7 +577,16 @@ pub fn reconstruct_mesh(mesh: &TriMesh, params: &SegmentParams) -> Result<Recons
         let surfaces: Vec<SurfaceParams> = seg.surfaces.iter().map(|s| s.params).collect();
         (labels, surfaces, "vertices")
     };
+    let mut labels = labels;
+    let merges = snap::merge_indistinct(
+        positions,
+        &mesh.faces,
+        &face_areas(mesh),
+        &mut labels,
+        &surfaces,
+    );
     let mut rec = brep_from_mesh(mesh, &labels, &surfaces)?;
+    rec.report.snaps.splice(0..0, merges);
     rec.report.noise_ratio = noise;
     rec.report.segmentation = how;
     Ok(rec)
@@ -743,6 +781,103 @@ impl Brep {
             e.faces.swap(0, 1);
         }
     }
+}
+
+/// Points along an edge: its vertices, a circle's arc, a B-spline's samples.
+fn edge_points(edge: &BrepEdge, vertices: &[Point3]) -> Vec<Point3> {
+    let (p0, p1) = (vertices[edge.start], vertices[edge.end]);
+    match &edge.curve {
+        Curve::Line { .. } => vec![p0, p1],
+        Curve::BSpline { .. } => edge.curve.samples(),
+        Curve::Circle {
+            center,
+            axis,
+            ref_dir,
+            radius,
+        } => {
+            let b = cross(*axis, *ref_dir);
+            let angle = |p: Point3| {
+                let v = sub(p, *center);
+                dot(v, b).atan2(dot(v, *ref_dir))
+            };
+            let tau = std::f64::consts::TAU;
+            let (a0, a1) = (angle(p0), angle(p1));
+            // The arc from p0 to p1 along the edge's direction (a whole turn when closed).
+            let sweep = if edge.start == edge.end {
+                tau
+            } else if edge.curve_sense {
+                (a1 - a0).rem_euclid(tau)
+            } else {
+                -(a0 - a1).rem_euclid(tau)
+            };
+            let sweep = if edge.curve_sense {
+                sweep
+            } else {
+                -sweep.abs()
+            };
+            (0..=64)
+                .map(|i| {
+                    let a = a0 + sweep * i as f64 / 64.0;
+                    [0, 1, 2].map(|k| center[k] + radius * (a.cos() * ref_dir[k] + a.sin() * b[k]))
+                })
+                .collect()
+        }
+    }
+}
+
+/// See [`BrepFace::seam`]: the middle of the widest angular gap between the face's boundary
+/// points around the axis (edges that are circles about the axis itself are left out: every
+/// seam crosses them).
+fn seam_direction(
+    surface: &SurfaceParams,
+    loops: &[Vec<(usize, bool)>],
+    edges: &[BrepEdge],
+    vertices: &[Point3],
+) -> Option<Point3> {
+    let (o, d) = match *surface {
+        SurfaceParams::Cylinder {
+            axis_point,
+            axis_dir,
+            ..
+        } => (axis_point, axis_dir),
+        SurfaceParams::Cone { apex, axis_dir, .. } => (apex, axis_dir),
+        SurfaceParams::Torus {
+            center, axis_dir, ..
+        } => (center, axis_dir),
+        _ => return None,
+    };
+    let u = step::perpendicular(d);
+    let v = cross(d, u);
+    let mut angles: Vec<f64> = Vec::new();
+    for &(e, _) in loops.iter().flatten() {
+        let edge = &edges[e];
+        if let Curve::Circle { center, axis, .. } = edge.curve {
+            let c = sub(center, o);
+            if 1.0 - dot(axis, d).abs() < 1e-9 && norm(cross(c, d)) <= 1e-9 * (1.0 + norm(c)) {
+                continue;
+            }
+        }
+        for p in edge_points(edge, vertices) {
+            let r = sub(p, o);
+            angles.push(dot(r, v).atan2(dot(r, u)));
+        }
+    }
+    if angles.is_empty() {
+        return None;
+    }
+    angles.sort_by(f64::total_cmp);
+    let tau = std::f64::consts::TAU;
+    let mut best = (
+        angles[0] + tau - angles[angles.len() - 1],
+        angles[angles.len() - 1],
+    );
+    for w in angles.windows(2) {
+        if w[1] - w[0] > best.0 {
+            best = (w[1] - w[0], w[0]);
+        }
+    }
+    let mid = best.1 + 0.5 * best.0;
+    normalize([0, 1, 2].map(|k| mid.cos() * u[k] + mid.sin() * v[k]))
 }
 
 /// Signed area of a loop in the plane of normal `n`, from its edges' polylines (vertices and

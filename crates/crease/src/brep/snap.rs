@@ -123,10 +123,15 @@ pub(crate) fn snap(
     size: f64,
 ) -> Vec<Snap> {
     let mut snaps = Vec::new();
+    // No tolerance at all for a surface without a face (dissolved into its neighbours).
     let tolerances = |a: usize, b: usize| {
         let d = (3.0 * stats[a].rms.max(stats[b].rms)).max(1e-9 * size);
-        let extent = stats[a].extent.min(stats[b].extent).max(1e-300);
-        (d, d / extent)
+        let extent = stats[a].extent.min(stats[b].extent);
+        if extent > 0.0 {
+            (d, d / extent)
+        } else {
+            (0.0, 0.0)
+        }
     };
     // Larger faces first.
     let mut pairs: Vec<(usize, usize)> = adjacent.to_vec();
@@ -138,7 +143,7 @@ pub(crate) fn snap(
     // 0: planes made parallel to a larger plane whose normal is within the tolerance, or
     // perpendicular to the larger ones they nearly are perpendicular to.
     let mut planes: Vec<usize> = (0..surfaces.len())
-        .filter(|&i| matches!(surfaces[i], SurfaceParams::Plane { .. }))
+        .filter(|&i| matches!(surfaces[i], SurfaceParams::Plane { .. }) && stats[i].area > 0.0)
         .collect();
     planes.sort_by(|&x, &y| stats[y].area.total_cmp(&stats[x].area).then(x.cmp(&y)));
     let mut directions: Vec<(Point3, usize)> = Vec::new();
@@ -301,6 +306,155 @@ pub(crate) fn snap(
         }
     }
     snaps
+}
+
+/// How much worse than their own fits the neighbouring surfaces may explain a smaller region's
+/// vertices for the region to be dissolved into them.
+pub const MERGE_RMS_RATIO: f64 = 1.5;
+
+/// Dissolves regions the data cannot tell from their neighbours: a region (the triangles
+/// labelled `a`) whose triangles' centroids its larger adjacent surfaces fit, each by the
+/// nearest of them, with an RMS distance at most [`MERGE_RMS_RATIO`] times the largest own RMS among
+/// `a` and those surfaces, gives each of its triangles to the surface nearest the triangle's
+/// centroid (a plane fitted to a strip of a noisy cylinder, or to the saddle where two
+/// cylinders meet; a plane split in two). Smaller regions first; returns what was dissolved.
+pub(crate) fn merge_indistinct(
+    positions: &[Point3],
+    faces: &[[u32; 3]],
+    areas: &[f64],
+    labels: &mut [i32],
+    surfaces: &[SurfaceParams],
+) -> Vec<Snap> {
+    use crate::geometry::surface::signed_distance;
+    let ns = surfaces.len();
+    let mut area = vec![0.0; ns];
+    let mut sq = vec![0.0; ns];
+    let mut count = vec![0usize; ns];
+    let mut tris: Vec<Vec<usize>> = vec![Vec::new(); ns];
+    // Residuals at the triangles' centroids: on a coarse CAD mesh every vertex may lie on an
+    // edge, and so on the neighbouring surface too.
+    let centroid = |t: usize| {
+        let f = faces[t];
+        [0, 1, 2].map(|k| {
+            (positions[f[0] as usize][k]
+                + positions[f[1] as usize][k]
+                + positions[f[2] as usize][k])
+                / 3.0
+        })
+    };
+    for (t, _) in faces.iter().enumerate() {
+        let Ok(l) = usize::try_from(labels[t]) else {
+            continue;
+        };
+        area[l] += areas[t];
+        tris[l].push(t);
+        let d = signed_distance(&surfaces[l], centroid(t));
+        sq[l] += d * d;
+        count[l] += 1;
+    }
+    // Neighbouring labels: two labels on the triangles around one vertex.
+    let mut around: Vec<Vec<i32>> = vec![Vec::new(); positions.len()];
+    for (t, f) in faces.iter().enumerate() {
+        if labels[t] >= 0 {
+            for &v in f {
+                around[v as usize].push(labels[t]);
+            }
+        }
+    }
+    let mut neighbours: Vec<Vec<usize>> = vec![Vec::new(); ns];
+    for a in &mut around {
+        a.sort_unstable();
+        a.dedup();
+        for &x in a.iter() {
+            for &y in a.iter() {
+                if x != y {
+                    neighbours[x as usize].push(y as usize);
+                }
+            }
+        }
+    }
+    drop(around);
+    for n in &mut neighbours {
+        n.sort_unstable();
+        n.dedup();
+    }
+    let mut order: Vec<usize> = (0..ns).filter(|&l| !tris[l].is_empty()).collect();
+    order.sort_by(|&x, &y| area[x].total_cmp(&area[y]).then(x.cmp(&y)));
+    let mut merges = Vec::new();
+    for a in order {
+        let larger: Vec<usize> = neighbours[a]
+            .iter()
+            .copied()
+            .filter(|&b| !tris[b].is_empty() && (area[b], b) > (area[a], a))
+            .collect();
+        if larger.is_empty() || tris[a].is_empty() {
+            continue;
+        }
+        let rms = |l: usize| (sq[l] / count[l].max(1) as f64).sqrt();
+        let nearest = |p: Point3| {
+            larger
+                .iter()
+                .map(|&b| (signed_distance(&surfaces[b], p).abs(), b))
+                .fold(
+                    (f64::INFINITY, usize::MAX),
+                    |m, x| if x.0 < m.0 { x } else { m },
+                )
+        };
+        let (mut cross, mut n) = (0.0, 0usize);
+        for &t in &tris[a] {
+            cross += nearest(centroid(t)).0.powi(2);
+            n += 1;
+        }
+        let rms_cross = (cross / n.max(1) as f64).sqrt();
+        let own = larger.iter().map(|&b| rms(b)).fold(rms(a), f64::max);
+        if rms_cross > MERGE_RMS_RATIO * own {
+            continue;
+        }
+        let moved = std::mem::take(&mut tris[a]);
+        let mut into: Vec<usize> = Vec::new();
+        for t in moved {
+            let f = faces[t];
+            let c = [0, 1, 2].map(|k| {
+                (positions[f[0] as usize][k]
+                    + positions[f[1] as usize][k]
+                    + positions[f[2] as usize][k])
+                    / 3.0
+            });
+            let (_, b) = nearest(c);
+            labels[t] = b as i32;
+            area[b] += areas[t];
+            for &v in &f {
+                sq[b] += signed_distance(&surfaces[b], positions[v as usize]).powi(2);
+                count[b] += 1;
+            }
+            tris[b].push(t);
+            if !into.contains(&b) {
+                into.push(b);
+            }
+        }
+        area[a] = 0.0;
+        for &b in &into {
+            for &x in &neighbours[a].clone() {
+                if x != b && !neighbours[b].contains(&x) {
+                    neighbours[b].push(x);
+                }
+            }
+        }
+        merges.push(Snap {
+            relation: format!(
+                "{} dissolved into the surfaces it lies on ({})",
+                surfaces[a].kind().name(),
+                into.iter()
+                    .map(|b| b.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            surface: a,
+            to: into[0],
+            off_by: rms_cross,
+        });
+    }
+    merges
 }
 
 #[cfg(test)]

@@ -113,10 +113,12 @@ impl Entities {
 
     /// The surface, its parametrisation's seam (and a sphere's poles) placed away from the
     /// face whose mean normal is `direction`: a sphere's pole at the middle of the face (never
-    /// on its border), the seam of a surface of revolution on the side opposite the face.
-    fn surface(&mut self, s: &SurfaceParams, direction: Point3) -> usize {
+    /// on its border), the seam of a surface of revolution along `seam` when given (where the
+    /// face's boundary leaves the widest gap), else on the side opposite the face.
+    fn surface(&mut self, s: &SurfaceParams, direction: Point3, seam: Option<Point3>) -> usize {
         let away = |axis: Point3| {
-            normalize(sub(scale(axis, dot(direction, axis)), direction))
+            seam.and_then(|x| normalize(sub(x, scale(axis, dot(x, axis)))))
+                .or_else(|| normalize(sub(scale(axis, dot(direction, axis)), direction)))
                 .unwrap_or_else(|| perpendicular(axis))
         };
         match *s {
@@ -282,7 +284,7 @@ pub fn to_step(brep: &Brep, name: &str, unit: LengthUnit, uncertainty: f64) -> S
         .collect();
     let mut faces = Vec::with_capacity(brep.faces.len());
     for face in &brep.faces {
-        let surface = e.surface(&face.surface, face.direction);
+        let surface = e.surface(&face.surface, face.direction, face.seam);
         let mut bounds = Vec::with_capacity(face.loops.len());
         for (li, lp) in face.loops.iter().enumerate() {
             let oriented: Vec<usize> = lp

@@ -110,9 +110,97 @@ fn half_edges(mesh: &TriMesh) -> Result<HalfEdges<'_>> {
     Ok(HalfEdges { faces, twin })
 }
 
+/// A second patch of a surface smaller than this fraction of the surface's largest patch is
+/// taken for noise along a border and joins the region around it.
+pub(crate) const ISLAND_FRACTION: f64 = 0.05;
+
+/// Connected components of triangles with equal labels: per triangle its component, and the
+/// number of components.
+fn components(he: &HalfEdges, label: &[i32]) -> (Vec<u32>, usize) {
+    let nt = label.len();
+    let mut comp = vec![NONE; nt];
+    let mut n = 0u32;
+    for s in 0..nt {
+        if comp[s] != NONE {
+            continue;
+        }
+        comp[s] = n;
+        let mut stack = vec![s];
+        while let Some(t) = stack.pop() {
+            for i in 0..3 {
+                if let Some(o) = he.twin(3 * t + i) {
+                    let u = o / 3;
+                    if comp[u] == NONE && label[u] == label[t] {
+                        comp[u] = n;
+                        stack.push(u);
+                    }
+                }
+            }
+        }
+        n += 1;
+    }
+    (comp, n as usize)
+}
+
+/// Relabels the islands (see [`ISLAND_FRACTION`]) with the label of the neighbouring patch they
+/// share most mesh edges with; up to three rounds (an island inside an island).
+fn absorb_islands(he: &HalfEdges, label: &mut [i32], areas: &[f64]) {
+    for _ in 0..3 {
+        let (comp, n) = components(he, label);
+        let mut area = vec![0.0; n];
+        let mut of = vec![0i32; n];
+        for (t, &c) in comp.iter().enumerate() {
+            area[c as usize] += areas[t];
+            of[c as usize] = label[t];
+        }
+        let mut largest: std::collections::HashMap<i32, f64> = std::collections::HashMap::new();
+        for c in 0..n {
+            let e = largest.entry(of[c]).or_insert(0.0);
+            *e = e.max(area[c]);
+        }
+        let island: Vec<bool> = (0..n)
+            .map(|c| area[c] < ISLAND_FRACTION * largest[&of[c]])
+            .collect();
+        if !island.contains(&true) {
+            return;
+        }
+        // Shared mesh edges between an island and each neighbouring patch.
+        let mut shared: std::collections::BTreeMap<(u32, u32), usize> = Default::default();
+        for h in 0..comp.len() * 3 {
+            let c = comp[h / 3];
+            if !island[c as usize] {
+                continue;
+            }
+            if let Some(o) = he.twin(h) {
+                let d = comp[o / 3];
+                if d != c {
+                    *shared.entry((c, d)).or_insert(0) += 1;
+                }
+            }
+        }
+        let mut target: Vec<Option<(usize, i32)>> = vec![None; n];
+        for (&(c, d), &count) in &shared {
+            let l = of[d as usize];
+            let better = match target[c as usize] {
+                None => true,
+                Some((k, tl)) => count > k || (count == k && l < tl),
+            };
+            if better {
+                target[c as usize] = Some((count, l));
+            }
+        }
+        for (t, &c) in comp.iter().enumerate() {
+            if let Some((_, l)) = target[c as usize] {
+                label[t] = l;
+            }
+        }
+    }
+}
+
 /// Regions: connected components of triangles with the same label (unlabelled triangles first
-/// take the label of the nearest labelled ones across edges, breadth first).
-fn regions(he: &HalfEdges, labels: &[i32]) -> Result<(Vec<u32>, Vec<usize>)> {
+/// take the label of the nearest labelled ones across edges, breadth first; islands join the
+/// region around them, [`absorb_islands`]).
+fn regions(he: &HalfEdges, labels: &[i32], areas: &[f64]) -> Result<(Vec<u32>, Vec<usize>)> {
     let nt = he.faces.len();
     let mut label = labels.to_vec();
     let mut frontier: Vec<usize> = (0..nt).filter(|&t| label[t] >= 0).collect();
@@ -146,6 +234,7 @@ fn regions(he: &HalfEdges, labels: &[i32]) -> Result<(Vec<u32>, Vec<usize>)> {
         }
         frontier = next;
     }
+    absorb_islands(he, &mut label, areas);
     let mut region = vec![NONE; nt];
     let mut surface_of_region = Vec::new();
     for s in 0..nt {
@@ -264,7 +353,8 @@ pub(crate) fn topology(
         ));
     }
     let he = half_edges(mesh)?;
-    let (mut region, mut surface_of_region) = regions(&he, labels)?;
+    let areas = crate::geometry::face_areas(mesh);
+    let (mut region, mut surface_of_region) = regions(&he, labels, &areas)?;
     let cuts = cut_closed_regions(mesh, &he, &mut region, &mut surface_of_region, surfaces)?;
     let nr = surface_of_region.len();
     let nh = region.len() * 3;
