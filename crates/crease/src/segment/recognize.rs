@@ -82,9 +82,24 @@ fn line_distance(p: Point3, q: Point3, d: Point3) -> f64 {
     norm(cross(sub(p, q), d))
 }
 
+/// The most surfaces [`recognize`] groups. A part has a few dozen to a few hundred surfaces; a
+/// segmentation of thousands is fragmented (a noisy mesh whose regions are single triangles),
+/// its groups mean nothing, and the extrusion search, quadratic in the surfaces, would take
+/// hours on it (a noisy 1M-triangle mesh: 50k planes).
+pub const MAX_RECOGNIZED_SURFACES: usize = 2000;
+
 /// Recognises fillets, extrusions and revolutions among `surfaces` (their `neighbours` give
-/// the adjacency). Deterministic: surfaces are visited in id order.
+/// the adjacency); none beyond [`MAX_RECOGNIZED_SURFACES`] surfaces (with a warning).
+/// Deterministic: surfaces are visited in id order.
 pub fn recognize(surfaces: &[SegmentSurface], angle_tol: f64, position_tol: f64) -> Vec<Group> {
+    if surfaces.len() > MAX_RECOGNIZED_SURFACES {
+        tracing::warn!(
+            "{} surfaces: the segmentation is fragmented; fillets, extrusions and revolutions \
+             are not looked for beyond {MAX_RECOGNIZED_SURFACES}",
+            surfaces.len()
+        );
+        return Vec::new();
+    }
     let parallel = |a: Point3, b: Point3| dot(a, b).abs() > angle_tol.cos();
     let orthogonal = |a: Point3, b: Point3| dot(a, b).abs() < angle_tol.sin();
     let mut groups = Vec::new();
