@@ -337,6 +337,13 @@ fn demo_writes_its_results() {
     assert_eq!(v["points"], 20000);
     assert!(v["sharp_points"].as_u64().unwrap() > 0);
     assert_eq!(v["mesh"]["closed_manifold"], true);
+    // The demo part's mesh as a B-rep: a solid of 8 planes, a cylinder and a cone (its STEP
+    // file is checked by OpenCASCADE in reconstruct_cli).
+    assert_eq!(v["brep"]["solid"], true);
+    assert_eq!(
+        v["brep"]["faces"],
+        serde_json::json!({"cone": 1, "cylinder": 1, "plane": 8})
+    );
     // Oriented PCA normals of the noisy demo part: most points are on flat faces, so the median
     // error is small; the 95th percentile is dominated by points next to sharp edges.
     let median = v["normals"]["angle_error_degrees"]["median"]
