@@ -1,21 +1,32 @@
 //! Scan to CAD: a boundary representation (B-rep) of the part, written as a STEP file.
 //!
-//! From a triangle mesh and its segmentation into analytic surfaces ([`crate::segment`]):
+//! From a triangle mesh and its segmentation into analytic surfaces ([`crate::segment`]; a
+//! noisy mesh through its vertices, see [`reconstruct_mesh`]):
 //! 1. topology (`topology`): faces are the connected regions of triangles on one surface,
 //!    edges the chains of mesh edges between two regions, vertices where three or more meet;
-//! 2. vertices (`intersect::on_surfaces`): solved from the surfaces that meet there, by
-//!    Gauss–Newton from the mesh vertex, not taken from the (noisy) mesh;
-//! 3. edges (`intersect::analytic_curve`): the exact intersection line or circle of the two
-//!    faces' surfaces where the pair has one, otherwise a B-spline through the chain's
-//!    vertices moved onto both surfaces;
-//! 4. faces: the analytic surface, oriented like the mesh (outward on a closed part), bounded
-//!    by the loops of oriented edges;
-//! 5. output ([`step`]): a `MANIFOLD_SOLID_BREP` when every edge has a face on both sides, an
+//!    islands of a surface inside another region are absorbed;
+//! 2. snapping ([`snap`]): regions their neighbours explain as well dissolved into them, then
+//!    planes made parallel or perpendicular, axes made a plane's normal or parallel to it,
+//!    coaxial surfaces put on one axis, each within the measured noise and reported;
+//! 3. vertices (`intersect::on_surfaces`): solved from the surfaces that meet there, by
+//!    Gauss–Newton from the mesh vertex, not taken from the (noisy) mesh; edges whose two ends
+//!    then coincide (faces touching in a point) are collapsed;
+//! 4. edges (`intersect::analytic_curve`): the exact intersection line or circle of the two
+//!    faces' surfaces where the pair has one, otherwise a cubic B-spline through the chain's
+//!    vertices moved onto both surfaces, refined until it stays on them;
+//! 5. faces: the analytic surface, oriented like the mesh (outward on a closed part), bounded
+//!    by the loops of oriented edges, its seam placed off its boundary;
+//! 6. a check: a vertex or an edge farther than [`MAX_GAP`] mesh edges from one of its
+//!    surfaces refuses the part (the surfaces found do not meet) rather than give an invalid
+//!    B-rep;
+//! 7. output ([`step`]): a `MANIFOLD_SOLID_BREP` when every edge has a face on both sides, an
 //!    `OPEN_SHELL` (with a warning naming the border) otherwise.
 //!
-//! Not yet done (issue "scan to CAD"): point clouds, snapping of near relations (parallel
-//! planes, coaxial cylinders, tangent fillets), ellipses and smooth B-splines for the curves
-//! without a closed form.
+//! Not yet done (issue "scan to CAD"): point clouds; an open shell instead of a refusal when
+//! some surfaces do not meet; tangent fillets snapped to their neighbours; ellipses for oblique
+//! plane–cylinder edges; circles on the border of open shells (polylines today); a whole
+//! sphere or torus as one face with a seam edge (two faces today). Measured figures:
+//! `docs/experiments/brep.md`.
 
 pub(crate) mod intersect;
 pub mod snap;
