@@ -223,6 +223,15 @@ fn open_surfaces_become_valid_open_shells_with_a_warning() {
         assert_eq!(occ["solids"], 0, "{shape}: {occ}");
         assert_eq!(occ["closed_shells"], 0, "{shape}: {occ}");
         assert_eq!(faces(&occ), vec![(kind.to_string(), 1)], "{shape}: {occ}");
+        // A planar border of a surface of revolution is its exact circle (the tube's ends).
+        let summary = reconstruct(&mesh, &dir.path().join(format!("{shape}-2.step")));
+        if shape != "plane" {
+            assert_eq!(
+                summary["report"]["edges_by_curve"],
+                serde_json::json!({"circle": 2}),
+                "{shape}"
+            );
+        }
         // The face covers the mesh: areas agree within the chords.
         let area = occ["area"].as_f64().expect("area");
         let mesh_area = match shape {

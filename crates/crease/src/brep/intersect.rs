@@ -17,8 +17,9 @@
 //!   a plane through a torus's axis: the tube circle through the start vertex;
 //! - anything else (an oblique plane through a cylinder, two crossing cylinders): the cubic
 //!   B-spline interpolating the mesh chain's vertices moved onto both surfaces (`interpolate`);
-//! - the mesh border (one surface): the degree-1 B-spline through the chain's vertices moved
-//!   onto the surface (a border may have corners).
+//! - the mesh border (one surface): the surface's curve in the border's plane when the border
+//!   is planar, a line where it is straight on a plane, else the degree-1 B-spline through the
+//!   chain's vertices moved onto the surface (a border may have corners).
 
 use crate::geometry::surface::{signed_distance, surface_normal};
 use crate::geometry::vec3::{add, cross, dist, dot, norm, normalize, scale, sub};

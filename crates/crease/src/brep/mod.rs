@@ -24,8 +24,10 @@
 //!
 //! Not yet done (issue "scan to CAD"): point clouds; an open shell instead of a refusal when
 //! some surfaces do not meet; tangent fillets snapped to their neighbours; ellipses for oblique
-//! plane–cylinder edges; circles on the border of open shells (polylines today); a whole
-//! sphere or torus as one face with a seam edge (two faces today). Measured figures:
+//! plane–cylinder edges; a whole sphere or torus as one face with a seam edge (two faces
+//! today). The border of an open shell is the surface's curve in the border's plane when the
+//! border is planar (a tube's circular ends), a line where it is straight on a plane, and the
+//! mesh's polyline otherwise. Measured figures:
 //! `docs/experiments/brep.md`.
 
 pub(crate) mod intersect;
@@ -375,6 +377,11 @@ pub fn brep_from_mesh(
         let (p0, p1) = (vertices[e.start], vertices[e.end]);
         let analytic = match surfs.as_slice() {
             [a, b] => intersect::analytic_curve(a, b, p0, p1, size),
+            // A border that lies in a plane (a tube cut square, a scan's planar rim): the
+            // surface's intersection with that plane.
+            [a] => border_plane(&e.chain, &pos, spacing)
+                .and_then(|plane| intersect::analytic_curve(a, &plane, p0, p1, size))
+                .or_else(|| border_line(a, &e.chain, &pos, p0, p1, spacing)),
             _ => None,
         };
         let (curve, curve_sense) = match analytic {
@@ -690,6 +697,45 @@ fn solve_vertices(
         .map(|(&mv, surfs)| intersect::on_surfaces(surfs, pos(mv)))
         .collect();
     (at_vertex, vertices)
+}
+
+/// The plane of a border chain, when its mesh vertices lie in one within a tenth of the mesh
+/// spacing (RMS).
+fn border_plane(chain: &[u32], pos: &dyn Fn(u32) -> Point3, spacing: f64) -> Option<SurfaceParams> {
+    if chain.len() < 4 {
+        return None;
+    }
+    let plane = crate::geometry::fit_plane(chain.iter().map(|&v| (pos(v), 1.0)))?;
+    let rms = plane.eigenvalues[0].max(0.0).sqrt();
+    let flat = rms <= 0.1 * spacing;
+    // A straight border (a line: two vanishing eigenvalues) has no plane of its own.
+    let straight = plane.eigenvalues[1].max(0.0).sqrt() <= 0.1 * spacing;
+    if !flat || straight {
+        return None;
+    }
+    Some(SurfaceParams::Plane {
+        normal: plane.normal,
+        offset: dot(plane.normal, plane.centroid),
+    })
+}
+
+/// The line of a straight border chain on a plane (its mesh vertices within a tenth of the mesh
+/// spacing, RMS, of the line through its ends).
+fn border_line(
+    surface: &SurfaceParams,
+    chain: &[u32],
+    pos: &dyn Fn(u32) -> Point3,
+    p0: Point3,
+    p1: Point3,
+    spacing: f64,
+) -> Option<Curve> {
+    if !matches!(surface, SurfaceParams::Plane { .. }) || chain.first() == chain.last() {
+        return None;
+    }
+    let dir = normalize(sub(p1, p0))?;
+    let line = Curve::Line { origin: p0, dir };
+    let sq: f64 = chain.iter().map(|&v| line.distance(pos(v)).powi(2)).sum();
+    ((sq / chain.len() as f64).sqrt() <= 0.1 * spacing).then_some(line)
 }
 
 /// The points of a chain moved onto a curve, thinned to a monotone sequence: a point is kept
