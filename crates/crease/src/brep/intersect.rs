@@ -22,7 +22,7 @@
 //!   chain's vertices moved onto the surface (a border may have corners).
 
 use crate::geometry::surface::{signed_distance, surface_normal};
-use crate::geometry::vec3::{add, cross, dist, dot, norm, normalize, scale, sub};
+use crate::geometry::vec3::{add, cross, dist, dot, line_distance, norm, normalize, scale, sub};
 use crate::geometry::{Point3, SurfaceParams};
 
 use super::Curve;
@@ -82,28 +82,13 @@ fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<Point3> {
 /// a sphere's is any line through its centre, returned as `None` direction).
 fn axis(s: &SurfaceParams) -> Option<(Point3, Option<Point3>)> {
     match *s {
-        SurfaceParams::Plane { .. } => None,
-        SurfaceParams::Cylinder {
-            axis_point,
-            axis_dir,
-            ..
-        } => Some((axis_point, Some(axis_dir))),
-        SurfaceParams::Cone { apex, axis_dir, .. } => Some((apex, Some(axis_dir))),
         SurfaceParams::Sphere { center, .. } => Some((center, None)),
-        SurfaceParams::Torus {
-            center, axis_dir, ..
-        } => Some((center, Some(axis_dir))),
+        _ => s.axis().map(|(p, d)| (p, Some(d))),
     }
 }
 
 fn parallel(a: Point3, b: Point3) -> bool {
     1.0 - dot(a, b).abs() <= PARALLEL
-}
-
-/// Distance from `p` to the line through `o` along the unit `d`.
-fn to_line(p: Point3, o: Point3, d: Point3) -> f64 {
-    let v = sub(p, o);
-    norm(sub(v, scale(d, dot(v, d))))
 }
 
 /// The line through `start` along `±d`, pointing towards `end`.
@@ -182,11 +167,17 @@ pub(crate) fn analytic_curve(
             let (oa, da) = axis(a)?;
             let (ob, db) = axis(b)?;
             match (da, db) {
-                (Some(da), Some(db)) if parallel(da, db) && to_line(ob, oa, da) <= on_axis => {
+                (Some(da), Some(db))
+                    if parallel(da, db) && line_distance(ob, oa, da) <= on_axis =>
+                {
                     circle_through(oa, da, start)
                 }
-                (Some(d), None) if to_line(ob, oa, d) <= on_axis => circle_through(oa, d, start),
-                (None, Some(d)) if to_line(oa, ob, d) <= on_axis => circle_through(ob, d, start),
+                (Some(d), None) if line_distance(ob, oa, d) <= on_axis => {
+                    circle_through(oa, d, start)
+                }
+                (None, Some(d)) if line_distance(oa, ob, d) <= on_axis => {
+                    circle_through(ob, d, start)
+                }
                 _ => None,
             }
         }

@@ -329,7 +329,7 @@ pub fn brep_from_mesh(
     // that touch in a point, as a plane touches a fillet's corner ball) are removed and their
     // ends merged, and the merged vertices solved again.
     let (mut at_vertex, mut vertices) = solve_vertices(&topo, &edge_surfaces, &pos);
-    let spacing = mean_edge_length(mesh);
+    let spacing = crate::geometry::cleanup::mean_edge_length(&mesh.vertices.positions, &mesh.faces);
     let tol = 0.1 * spacing;
     let drop: Vec<bool> = topo
         .edges
@@ -796,21 +796,6 @@ fn spline_on(surfs: &[SurfaceParams], mut pts: Vec<Point3>, spacing: f64) -> Cur
     curve
 }
 
-/// Mean length of the mesh's triangle sides.
-fn mean_edge_length(mesh: &TriMesh) -> f64 {
-    let p = &mesh.vertices.positions;
-    let sum: f64 = mesh
-        .faces
-        .iter()
-        .map(|f| {
-            dist(p[f[0] as usize], p[f[1] as usize])
-                + dist(p[f[1] as usize], p[f[2] as usize])
-                + dist(p[f[2] as usize], p[f[0] as usize])
-        })
-        .sum();
-    sum / (3 * mesh.faces.len()).max(1) as f64
-}
-
 /// The volume enclosed by a closed mesh, positive when its triangles turn counter-clockwise
 /// seen from outside.
 fn signed_volume(mesh: &TriMesh) -> f64 {
@@ -891,18 +876,7 @@ fn seam_direction(
     edges: &[BrepEdge],
     vertices: &[Point3],
 ) -> Option<Point3> {
-    let (o, d) = match *surface {
-        SurfaceParams::Cylinder {
-            axis_point,
-            axis_dir,
-            ..
-        } => (axis_point, axis_dir),
-        SurfaceParams::Cone { apex, axis_dir, .. } => (apex, axis_dir),
-        SurfaceParams::Torus {
-            center, axis_dir, ..
-        } => (center, axis_dir),
-        _ => return None,
-    };
+    let (o, d) = surface.axis()?;
     let u = step::perpendicular(d);
     let v = cross(d, u);
     let mut angles: Vec<f64> = Vec::new();

@@ -26,7 +26,7 @@
 
 use serde::Serialize;
 
-use crate::geometry::vec3::{add, dist, dot, norm, normalize, scale, sub};
+use crate::geometry::vec3::{add, dist, dot, line_distance, normalize, scale, sub};
 use crate::geometry::{Point3, SurfaceParams};
 
 /// One relation made exact.
@@ -55,26 +55,11 @@ pub(crate) struct FaceStats {
     pub centroid: Point3,
 }
 
-fn axis_of(s: &SurfaceParams) -> Option<(Point3, Point3)> {
-    match *s {
-        SurfaceParams::Cylinder {
-            axis_point,
-            axis_dir,
-            ..
-        } => Some((axis_point, axis_dir)),
-        SurfaceParams::Cone { apex, axis_dir, .. } => Some((apex, axis_dir)),
-        SurfaceParams::Torus {
-            center, axis_dir, ..
-        } => Some((center, axis_dir)),
-        _ => None,
-    }
-}
-
 /// The surface with its axis moved to the line (`o`, `d`) (`d` unit, turned to agree with the
 /// old axis's direction); the axis point is the old one's foot on the new line, so the surface
 /// stays where its data is.
 fn with_axis(s: &SurfaceParams, o: Point3, d: Point3) -> SurfaceParams {
-    let Some((p, old)) = axis_of(s) else {
+    let Some((p, old)) = s.axis() else {
         return *s;
     };
     let d = if dot(d, old) < 0.0 { scale(d, -1.0) } else { d };
@@ -102,12 +87,6 @@ fn with_axis(s: &SurfaceParams, o: Point3, d: Point3) -> SurfaceParams {
         },
         other => other,
     }
-}
-
-/// Distance from `p` to the line (`o`, unit `d`).
-fn to_line(p: Point3, o: Point3, d: Point3) -> f64 {
-    let v = sub(p, o);
-    norm(sub(v, scale(d, dot(v, d))))
 }
 
 fn degrees(cos: f64) -> f64 {
@@ -204,7 +183,7 @@ pub(crate) fn snap(
             let SurfaceParams::Plane { normal, .. } = surfaces[p] else {
                 continue;
             };
-            let Some((o, d)) = axis_of(&surfaces[s]) else {
+            let Some((o, d)) = surfaces[s].axis() else {
                 continue;
             };
             if moved[s] {
@@ -255,9 +234,9 @@ pub(crate) fn snap(
             continue;
         }
         let (dtol, atol) = tolerances(big, small);
-        match (axis_of(&surfaces[big]), surfaces[small]) {
+        match (surfaces[big].axis(), surfaces[small]) {
             (Some((o, d)), SurfaceParams::Sphere { center, radius }) => {
-                let off = to_line(center, o, d);
+                let off = line_distance(center, o, d);
                 if off > 0.0 && off <= dtol {
                     let foot = add(o, scale(d, dot(sub(center, o), d)));
                     surfaces[small] = SurfaceParams::Sphere {
@@ -274,7 +253,7 @@ pub(crate) fn snap(
                 }
             }
             (Some((o, d)), s) => {
-                let Some((os, ds)) = axis_of(&s) else {
+                let Some((os, ds)) = s.axis() else {
                     continue;
                 };
                 let off_angle = degrees(dot(d, ds));
@@ -299,7 +278,7 @@ pub(crate) fn snap(
     }
     // Keep unit axes exact after the arithmetic.
     for s in surfaces.iter_mut() {
-        if let Some((o, d)) = axis_of(s) {
+        if let Some((o, d)) = s.axis() {
             if let Some(u) = normalize(d) {
                 *s = with_axis(s, o, u);
             }

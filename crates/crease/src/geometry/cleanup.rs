@@ -424,7 +424,7 @@ fn finite_aabb(positions: &[Point3]) -> Option<Aabb> {
 
 /// Mean length over all sides of the faces without a repeated vertex (finite lengths only),
 /// summed per fixed-size chunk so the result does not depend on the thread count.
-fn mean_edge_length(p: &[Point3], faces: &[[u32; 3]]) -> f64 {
+pub(crate) fn mean_edge_length(p: &[Point3], faces: &[[u32; 3]]) -> f64 {
     let partial: Vec<(f64, usize)> = faces
         .par_chunks(4096)
         .map(|chunk| {

@@ -112,6 +112,23 @@ pub enum SurfaceParams {
 }
 
 impl SurfaceParams {
+    /// The axis of a cylinder, cone or torus: a point on it (the axis point, the apex, the
+    /// centre) and its unit direction; none for a plane or a sphere.
+    pub fn axis(&self) -> Option<(Point3, Point3)> {
+        match *self {
+            SurfaceParams::Cylinder {
+                axis_point,
+                axis_dir,
+                ..
+            } => Some((axis_point, axis_dir)),
+            SurfaceParams::Cone { apex, axis_dir, .. } => Some((apex, axis_dir)),
+            SurfaceParams::Torus {
+                center, axis_dir, ..
+            } => Some((center, axis_dir)),
+            _ => None,
+        }
+    }
+
     /// The surface type of these parameters.
     pub fn kind(&self) -> SurfaceType {
         match self {

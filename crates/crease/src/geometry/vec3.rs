@@ -73,6 +73,12 @@ pub fn lerp(a: Point3, b: Point3, t: f64) -> Point3 {
     add(a, scale(sub(b, a), t))
 }
 
+/// Distance from `p` to the line through `q` along the unit direction `d`.
+#[inline]
+pub fn line_distance(p: Point3, q: Point3, d: Point3) -> f64 {
+    norm(cross(sub(p, q), d))
+}
+
 /// Angle in radians between a and b (0 if either is zero).
 #[inline]
 pub fn angle(a: Point3, b: Point3) -> f64 {

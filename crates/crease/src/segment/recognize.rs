@@ -23,7 +23,7 @@
 
 use serde::Serialize;
 
-use crate::geometry::vec3::{cross, dot, norm, normalize, sub};
+use crate::geometry::vec3::{cross, dot, line_distance, norm, normalize};
 use crate::geometry::Point3;
 use crate::geometry::{SurfaceParams, SurfaceType};
 
@@ -55,19 +55,9 @@ pub struct Group {
     pub point: Point3,
 }
 
+/// The axis as (direction, point).
 fn axis_of(s: &SurfaceParams) -> Option<(Point3, Point3)> {
-    match *s {
-        SurfaceParams::Cylinder {
-            axis_point,
-            axis_dir,
-            ..
-        } => Some((axis_dir, axis_point)),
-        SurfaceParams::Cone { apex, axis_dir, .. } => Some((axis_dir, apex)),
-        SurfaceParams::Torus {
-            center, axis_dir, ..
-        } => Some((axis_dir, center)),
-        _ => None,
-    }
+    s.axis().map(|(p, d)| (d, p))
 }
 
 fn plane_of(s: &SurfaceParams) -> Option<(Point3, f64)> {
@@ -75,11 +65,6 @@ fn plane_of(s: &SurfaceParams) -> Option<(Point3, f64)> {
         SurfaceParams::Plane { normal, offset } => Some((normal, offset)),
         _ => None,
     }
-}
-
-/// Distance from `p` to the line through `q` with unit direction `d`.
-fn line_distance(p: Point3, q: Point3, d: Point3) -> f64 {
-    norm(cross(sub(p, q), d))
 }
 
 /// The most surfaces [`recognize`] groups. A part has a few dozen to a few hundred surfaces; a
