@@ -1,14 +1,16 @@
 //! `crease reconstruct IN -o part.step [--topology topo.json] [--units mm]`: the part as a
 //! boundary representation (B-rep) in a STEP file (`crease::brep`): the mesh segmented into
 //! analytic surfaces, their intersection curves and vertices, a solid when the mesh is closed
-//! and an open shell otherwise.
+//! and an open shell otherwise. A point cloud goes through the shared analysis and its
+//! envelope (`crease::brep::reconstruct_cloud`).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use crease::brep::{reconstruct_mesh, to_step, LengthUnit};
+use crease::analysis::AnalysisParams;
+use crease::brep::{reconstruct_mesh, reconstruct_points, to_step, LengthUnit};
 use crease::geometry::TriMesh;
 use crease::segment::SegmentParams;
 
@@ -18,7 +20,8 @@ use crate::ui::{usage, Stage};
 /// Arguments of `crease reconstruct`.
 #[derive(Args, Debug)]
 pub struct ReconstructArgs {
-    /// Triangle mesh of the part (.ply .obj .off .stl), oriented and 2-manifold.
+    /// The part: a triangle mesh (.ply .obj .off .stl; oriented and 2-manifold) or a point
+    /// cloud (any format crease reads; normals are estimated).
     pub input: PathBuf,
     /// Output STEP file (.step or .stp).
     #[arg(short, long)]
@@ -69,22 +72,26 @@ pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
     };
     params.validate().map_err(|e| usage(e.to_string()))?;
     let (mut geom, _) = super::load(g, &a.input)?;
-    if !geom.is_mesh() {
-        anyhow::bail!(
-            "{}: is a point cloud; crease reconstruct builds B-reps from triangle meshes in this \
-             version",
-            a.input.display()
-        );
-    }
-    let mesh = TriMesh {
-        vertices: std::mem::take(&mut geom.points),
-        faces: std::mem::take(&mut geom.faces),
-        face_attributes: std::mem::take(&mut geom.face_attributes),
-    };
     let start = Instant::now();
     let stage = Stage::start("B-rep: surfaces, faces, edges, vertices", g.quiet);
-    let rec = reconstruct_mesh(&mesh, &params)
-        .with_context(|| format!("cannot build a B-rep of {}", a.input.display()))?;
+    let positions = if geom.is_mesh() {
+        let mesh = TriMesh {
+            vertices: std::mem::take(&mut geom.points),
+            faces: std::mem::take(&mut geom.faces),
+            face_attributes: std::mem::take(&mut geom.face_attributes),
+        };
+        let rec = reconstruct_mesh(&mesh, &params);
+        (rec, mesh.vertices.positions)
+    } else {
+        let analysis = AnalysisParams {
+            segment: params,
+            ..Default::default()
+        };
+        let positions = std::mem::take(&mut geom.points.positions);
+        (reconstruct_points(&positions, analysis), positions)
+    };
+    let (rec, positions) = positions;
+    let rec = rec.with_context(|| format!("cannot build a B-rep of {}", a.input.display()))?;
     stage.finish();
     let name = a
         .input
@@ -93,7 +100,7 @@ pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
         .unwrap_or_else(|| "part".into());
     // The file's uncertainty: the largest gap the kernel has to close, and never below the
     // round-off of the coordinates.
-    let size = crease::Aabb::from_points(&mesh.vertices.positions)
+    let size = crease::Aabb::from_points(&positions)
         .map(|b| b.diagonal())
         .unwrap_or(1.0);
     let uncertainty = (2.0 * rec.report.max_gap).max(1e-9 * size);

@@ -2,11 +2,12 @@
 //! samples of curves without a closed form), and the intersection curve of two adjacent faces,
 //! exact where it is a line or a circle.
 //!
-//! Points: damped Gauss–Newton on the signed distances, started from the mesh vertex. With as
-//! many surfaces as unknowns it converges to their common point; with fewer (two faces and a
-//! closed edge, a face and the mesh border) the damping keeps the step near the minimum-norm
-//! one, so the point stays near its start; with tangent faces (a fillet meeting a plane) the
-//! system is rank deficient and the damping keeps it solvable.
+//! Points: Levenberg–Marquardt on the signed distances, started from the mesh vertex. With as
+//! many surfaces as unknowns it converges to their common point in Gauss–Newton steps; with
+//! fewer (two faces and a closed edge, a face and the mesh border) the tiny damping keeps the
+//! step near the minimum-norm one, so the point stays near its start; with tangent faces (a
+//! fillet meeting a plane) the system is rank deficient, and a step that would overshoot along
+//! the tangent (faces that nearly touch but not quite) is refused and damped instead.
 //!
 //! Curves, in the order tried:
 //! - two planes: their line;
@@ -38,8 +39,8 @@ pub(crate) fn on_surfaces(surfaces: &[SurfaceParams], start: Point3) -> Point3 {
     if surfaces.is_empty() {
         return x;
     }
-    for _ in 0..100 {
-        // Normal equations (JᵀJ + μI) δ = −Jᵀr with μ a tiny fraction of the trace.
+    // Normal equations JᵀJ and −Jᵀr at `x`, and the cost Σ r².
+    let system = |x: Point3| {
         let mut a = [[0.0f64; 3]; 3];
         let mut b = [0.0f64; 3];
         let mut cost = 0.0;
@@ -54,20 +55,55 @@ pub(crate) fn on_surfaces(surfaces: &[SurfaceParams], start: Point3) -> Point3 {
                 }
             }
         }
-        if cost == 0.0 {
+        (a, b, cost)
+    };
+    let (mut a, mut b, mut cost) = system(x);
+    // Levenberg–Marquardt: the damping starts at a tiny fraction of the trace (a Gauss–Newton
+    // step) and grows tenfold whenever a step would raise the cost (the overshoot of nearly
+    // tangent surfaces that do not quite meet), shrinking again after a step that lowers it.
+    let trace = (a[0][0] + a[1][1] + a[2][2]).max(1e-300);
+    let mut mu = 1e-16 * trace;
+    for _ in 0..200 {
+        if cost == 0.0 || mu > 1e8 * trace {
             break;
         }
-        let mu = 1e-16 * (a[0][0] + a[1][1] + a[2][2]).max(1e-300);
-        for (i, row) in a.iter_mut().enumerate() {
+        let mut damped = a;
+        for (i, row) in damped.iter_mut().enumerate() {
             row[i] += mu;
         }
-        let Some(d) = solve3(a, b) else { break };
-        x = add(x, d);
-        if norm(d) <= 1e-15 * (1.0 + norm(x)) {
-            break;
+        let Some(d) = solve3(damped, b) else { break };
+        let next = add(x, d);
+        let (na, nb, ncost) = system(next);
+        if ncost <= cost {
+            (x, a, b, cost) = (next, na, nb, ncost);
+            mu = (mu / 10.0).max(1e-16 * trace);
+            if norm(d) <= 1e-15 * (1.0 + norm(x)) {
+                break;
+            }
+        } else {
+            mu *= 10.0;
         }
     }
     x
+}
+
+/// Where a plane and a ball among `surfaces` touch, if they do (to round-off, as snapping
+/// leaves a ball tangent to its faces): the vertex where a corner ball meets a face and its
+/// fillets. All the surfaces there share one normal, so their distances alone leave the point
+/// free to slide (to the square root of the round-off); the contact point does not.
+pub(crate) fn contact_point(surfaces: &[SurfaceParams]) -> Option<Point3> {
+    surfaces.iter().find_map(|p| {
+        let SurfaceParams::Plane { normal, offset } = *p else {
+            return None;
+        };
+        surfaces.iter().find_map(|s| {
+            let SurfaceParams::Sphere { center, radius } = *s else {
+                return None;
+            };
+            let h = dot(normal, center) - offset;
+            ((h.abs() - radius).abs() <= 1e-9 * radius).then(|| sub(center, scale(normal, h)))
+        })
+    })
 }
 
 fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<Point3> {

@@ -30,6 +30,7 @@
 //! mesh's polyline otherwise. Measured figures:
 //! `docs/experiments/brep.md`.
 
+pub(crate) mod envelope;
 pub(crate) mod intersect;
 pub mod snap;
 pub mod step;
@@ -55,6 +56,11 @@ pub use step::{to_step, LengthUnit};
 /// missed or mistyped by the segmentation), and the B-rep is refused rather than written
 /// invalid.
 pub const MAX_GAP: f64 = 0.1;
+
+/// The farthest a vertex may be solved from its mesh vertex, in mean mesh edge lengths: the
+/// mesh vertex of a junction lies within the noise and a few edges of it; farther, the surfaces
+/// meet elsewhere, not where the mesh's regions do, and the B-rep is refused.
+pub const MAX_MOVE: f64 = 10.0;
 
 /// The 3D curve of an edge.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -280,6 +286,25 @@ pub fn brep_from_mesh(
     face_surface: &[i32],
     surfaces: &[SurfaceParams],
 ) -> Result<Reconstruction> {
+    build(mesh, face_surface, surfaces, None)
+}
+
+/// Residuals of the data the surfaces were fitted to, when that is not the mesh the topology
+/// is read from (a cloud's envelope lies off the part by its dilation radius).
+struct Fit {
+    /// Per surface: RMS distance, extent, area and centroid of its points.
+    stats: Vec<snap::FaceStats>,
+    /// RMS distance of every assigned point to its surface.
+    rms: f64,
+}
+
+/// [`brep_from_mesh`], with the residuals measured on `fit` when given (else on the mesh).
+fn build(
+    mesh: &TriMesh,
+    face_surface: &[i32],
+    surfaces: &[SurfaceParams],
+    fit: Option<&Fit>,
+) -> Result<Reconstruction> {
     if let Some(&bad) = face_surface
         .iter()
         .find(|&&s| s >= 0 && s as usize >= surfaces.len())
@@ -297,7 +322,7 @@ pub fn brep_from_mesh(
         .ok_or_else(|| Error::InvalidInput("reconstruct: the mesh has no extent".into()))?;
     let nr = topo.surface_of_region.len();
     // Relations within the noise made exact (module `snap`).
-    let (surfaces, snaps) = snap_surfaces(mesh, &topo, surfaces, size);
+    let (surfaces, snaps) = snap_surfaces(mesh, &topo, surfaces, size, fit);
     let surfaces = &surfaces[..];
     let surface_of_region = topo.surface_of_region.clone();
     let cuts = topo.cuts.clone();
@@ -392,8 +417,9 @@ pub fn brep_from_mesh(
                 ref_dir,
                 radius,
             }) => {
-                let step = sub(pos(e.chain[1]), pos(e.chain[0]));
-                let sense = dot(step::circle_tangent(center, axis, p0), step) >= 0.0;
+                // The way the whole chain turns about the axis (its first step alone may
+                // point back on a jagged mesh such as a cloud's envelope).
+                let sense = turning(center, axis, ref_dir, e.chain.iter().map(|&v| pos(v))) >= 0.0;
                 (
                     Curve::Circle {
                         center,
@@ -440,6 +466,28 @@ pub fn brep_from_mesh(
                 (e.right != topology::OUTSIDE).then_some(e.right as usize),
             ],
         });
+    }
+    // A vertex solved far from where the mesh has it: the surfaces meet, but elsewhere (two
+    // nearly coaxial cylinders cross far away).
+    if let Some((v, moved)) = vertices
+        .iter()
+        .enumerate()
+        .map(|(v, p)| (v, dist(*p, pos(topo.vertices[v]))))
+        .find(|&(_, d)| d > MAX_MOVE * spacing)
+    {
+        let at = pos(topo.vertices[v]);
+        let kinds: Vec<&str> = at_vertex[v].iter().map(|s| s.kind().name()).collect();
+        return Err(Error::InvalidInput(format!(
+            "reconstruct: the surfaces found do not meet where the mesh says they do: near \
+             ({:.4}, {:.4}, {:.4}), the {} meet {moved:.3e} away ({:.1} mesh edges, at most \
+             {MAX_MOVE} allowed), so no valid B-rep can be built; the part's surfaces were not \
+             all found (free-form or too noisy?)",
+            at[0],
+            at[1],
+            at[2],
+            kinds.join(", "),
+            moved / spacing
+        )));
     }
     if max_gap > MAX_GAP * spacing {
         return Err(Error::InvalidInput(format!(
@@ -509,10 +557,22 @@ pub fn brep_from_mesh(
                 outer,
                 direction: direction[r],
                 seam: seam_direction(&surface, &topo.loops[r], &edges, &vertices),
-                rms: (face_sq[r] / face_count[r].max(1) as f64).sqrt(),
+                rms: match fit {
+                    Some(f) => f.stats[topo.surface_of_region[r]].rms,
+                    None => (face_sq[r] / face_count[r].max(1) as f64).sqrt(),
+                },
             }
         })
         .collect();
+    // A face whose every edge was collapsed (a ball touching a face in a point) is gone.
+    let (faces, edges) = drop_empty_faces(faces, edges);
+    let shells = shells(faces.len(), &edges);
+    if shells > 1 {
+        return Err(Error::InvalidInput(format!(
+            "reconstruct: the faces found form {shells} separate shells where the input is one \
+             piece (the surfaces found do not meet where the mesh says they do; too noisy?)"
+        )));
+    }
     let closed = border_edges == 0;
     let mut brep = Brep {
         vertices,
@@ -540,7 +600,10 @@ pub fn brep_from_mesh(
         vertices: brep.vertices.len(),
         closed,
         max_gap,
-        rms_distance: (sq / count.max(1) as f64).sqrt(),
+        rms_distance: match fit {
+            Some(f) => f.rms,
+            None => (sq / count.max(1) as f64).sqrt(),
+        },
         seams: topo.cuts.len(),
         snaps,
         warnings,
@@ -610,6 +673,175 @@ pub fn reconstruct_mesh(mesh: &TriMesh, params: &SegmentParams) -> Result<Recons
     Ok(rec)
 }
 
+/// The dilation radius of a cloud's envelope, in units of the 90th percentile of the distance
+/// from a point to its [`ENVELOPE_NEIGHBOUR`]-th neighbour: wide enough to close the gaps of a
+/// random sampling (the largest empty disc among a million uniform samples has about twice
+/// their spacing for radius), narrow enough to keep holes and slots a few spacings wide open.
+pub const ENVELOPE_RADIUS: f64 = 1.5;
+
+/// The neighbour whose distance measures the sampling for [`ENVELOPE_RADIUS`].
+pub const ENVELOPE_NEIGHBOUR: usize = 8;
+
+/// The B-rep of a point cloud, from its shared analysis (segmentation, neighbours).
+///
+/// A cloud has no triangles to read faces and edges from, so it is given some: its envelope
+/// (module `envelope`), the closed surface of the cloud dilated by [`ENVELOPE_RADIUS`] times
+/// its sampling distance, whose triangles take the surface of the samples nearest them (the
+/// majority of the 8 nearest assigned ones). The regions the point segmentation cannot tell
+/// from their neighbours are first dissolved into them ([`snap`]), on the points. Then
+/// [`brep_from_mesh`] on the envelope, with the residuals measured on the points: every
+/// vertex and edge comes from the surfaces, none from the envelope.
+///
+/// Errors: those of the segmentation and of [`brep_from_mesh`]; a cloud with no surface found.
+pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Reconstruction> {
+    use rayon::prelude::*;
+    let points = analysis.points();
+    let nbrs = analysis.neighbours()?;
+    let seg = analysis.segmentation()?;
+    let surfaces: Vec<SurfaceParams> = seg.surfaces.iter().map(|s| s.params).collect();
+    if surfaces.is_empty() {
+        return Err(Error::InvalidInput(
+            "reconstruct: no analytic surface was found in the cloud (a free-form object, or \
+             too few points)"
+                .into(),
+        ));
+    }
+    let mut labels = seg.point_surface.clone();
+    let merges = snap::merge_indistinct_points(
+        points,
+        &seg.point_area,
+        nbrs,
+        ENVELOPE_NEIGHBOUR,
+        &mut labels,
+        &surfaces,
+    );
+    // The sampling distance: the 90th percentile of the distance to the 8th neighbour.
+    let kth = ENVELOPE_NEIGHBOUR.min(nbrs.k());
+    let mut far: Vec<f64> = (0..points.len())
+        .into_par_iter()
+        .map(|i| {
+            nbrs.prefix(i, kth)
+                .last()
+                .map_or(0.0, |&j| dist(points[i], points[j as usize]))
+        })
+        .collect();
+    far.par_sort_unstable_by(f64::total_cmp);
+    let sampling = far[(far.len() * 9 / 10).min(far.len() - 1)];
+    let radius = ENVELOPE_RADIUS * sampling;
+    let index = crate::spatial::KdIndex::new(points)
+        .ok_or_else(|| Error::InvalidInput("reconstruct: no points".into()))?;
+    let env = envelope::envelope(points, &index, radius, radius / 2.0)?;
+    tracing::debug!(
+        "envelope: radius {:.3e}, cell {:.3e}, {} triangles",
+        env.radius,
+        env.cell,
+        env.mesh.faces.len()
+    );
+    if env.pieces > 1 {
+        return Err(Error::InvalidInput(format!(
+            "reconstruct: the cloud falls apart into {} pieces (its points, widened by {:.3e}, \
+             do not join up: a gap in the sampling, or several parts); crease reconstructs one \
+             part at a time",
+            env.pieces, env.radius
+        )));
+    }
+    // Each envelope vertex takes the majority surface of its 8 nearest assigned samples (ties:
+    // the nearest); a triangle the surface of two or three of its corners.
+    let vertex_label: Vec<i32> = env
+        .mesh
+        .vertices
+        .positions
+        .par_iter()
+        .map(|q| {
+            let near = index.nearest(q, ENVELOPE_NEIGHBOUR);
+            let mut best = (0usize, -1i32);
+            for (i, &(p, _)) in near.iter().enumerate() {
+                let l = labels[p as usize];
+                if l < 0 || near[..i].iter().any(|&(o, _)| labels[o as usize] == l) {
+                    continue;
+                }
+                let votes = near
+                    .iter()
+                    .filter(|&&(o, _)| labels[o as usize] == l)
+                    .count();
+                if votes > best.0 {
+                    best = (votes, l);
+                }
+            }
+            best.1
+        })
+        .collect();
+    let face_labels: Vec<i32> = env
+        .mesh
+        .faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|v| vertex_label[v as usize]);
+            if a == b || a == c {
+                a
+            } else if b == c {
+                b
+            } else {
+                -1
+            }
+        })
+        .collect();
+    // Residuals, extents, areas and centroids on the points.
+    let ns = surfaces.len();
+    let (mut sq, mut count, mut area) = (vec![0.0; ns], vec![0usize; ns], vec![0.0; ns]);
+    let mut sum = vec![[0.0; 3]; ns];
+    let mut boxes: Vec<Option<Aabb>> = vec![None; ns];
+    for ((p, &l), &a) in points.iter().zip(&labels).zip(&seg.point_area) {
+        if let Ok(l) = usize::try_from(l) {
+            sq[l] += signed_distance(&surfaces[l], *p).powi(2);
+            count[l] += 1;
+            area[l] += a;
+            for k in 0..3 {
+                sum[l][k] += p[k];
+            }
+            match &mut boxes[l] {
+                Some(b) => b.grow(*p),
+                None => boxes[l] = Some(Aabb { min: *p, max: *p }),
+            }
+        }
+    }
+    let fit = Fit {
+        stats: (0..ns)
+            .map(|s| {
+                let c = count[s].max(1) as f64;
+                snap::FaceStats {
+                    rms: (sq[s] / c).sqrt(),
+                    extent: boxes[s].map(|b| b.diagonal()).unwrap_or(0.0),
+                    area: area[s],
+                    centroid: sum[s].map(|x| x / c),
+                }
+            })
+            .collect(),
+        rms: (sq.iter().sum::<f64>() / count.iter().sum::<usize>().max(1) as f64).sqrt(),
+    };
+    let mut rec = build(&env.mesh, &face_labels, &surfaces, Some(&fit))?;
+    rec.report.snaps.splice(0..0, merges);
+    rec.report.noise_ratio = analysis.noise_ratio()?;
+    rec.report.segmentation = "points";
+    if env.dropped > 0 {
+        rec.report.warnings.push(format!(
+            "{} small clusters of points away from the part were left out",
+            env.dropped
+        ));
+    }
+    Ok(rec)
+}
+
+/// The B-rep of a point cloud (input order, any order): [`reconstruct_cloud`] on a new
+/// analysis with `params`.
+pub fn reconstruct_points(
+    points: &[Point3],
+    params: crate::analysis::AnalysisParams,
+) -> Result<Reconstruction> {
+    let analysis = crate::analysis::CloudAnalysis::new(points, params)?;
+    reconstruct_cloud(&analysis)
+}
+
 /// `surfaces` with the relations the mesh cannot tell from exact ones made exact (see
 /// `snap`), and what was snapped.
 fn snap_surfaces(
@@ -617,7 +849,19 @@ fn snap_surfaces(
     topo: &topology::Topology,
     surfaces: &[SurfaceParams],
     size: f64,
+    fit: Option<&Fit>,
 ) -> (Vec<SurfaceParams>, Vec<snap::Snap>) {
+    if let Some(f) = fit {
+        let mut snapped = surfaces.to_vec();
+        let snaps = snap::snap(
+            &mut snapped,
+            &adjacent_surfaces(topo),
+            &touching_surfaces(topo),
+            &f.stats,
+            size,
+        );
+        return (snapped, snaps);
+    }
     let ns = surfaces.len();
     let p = &mesh.vertices.positions;
     let areas = face_areas(mesh);
@@ -655,6 +899,46 @@ fn snap_surfaces(
             }
         })
         .collect();
+    let mut snapped = surfaces.to_vec();
+    let snaps = snap::snap(
+        &mut snapped,
+        &adjacent_surfaces(topo),
+        &touching_surfaces(topo),
+        &stats,
+        size,
+    );
+    (snapped, snaps)
+}
+
+/// The pairs of distinct surfaces whose regions share an edge or a vertex, ascending.
+fn touching_surfaces(topo: &topology::Topology) -> Vec<(usize, usize)> {
+    let mut at_vertex: Vec<Vec<usize>> = vec![Vec::new(); topo.vertices.len()];
+    for e in &topo.edges {
+        for r in [e.left, e.right] {
+            if r != topology::OUTSIDE {
+                let s = topo.surface_of_region[r as usize];
+                at_vertex[e.start].push(s);
+                at_vertex[e.end].push(s);
+            }
+        }
+    }
+    let mut pairs = Vec::new();
+    for mut v in at_vertex {
+        v.sort_unstable();
+        v.dedup();
+        for (i, &a) in v.iter().enumerate() {
+            for &b in &v[i + 1..] {
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
+}
+
+/// The pairs of distinct surfaces whose regions share an edge, ascending.
+fn adjacent_surfaces(topo: &topology::Topology) -> Vec<(usize, usize)> {
     let mut adjacent: Vec<(usize, usize)> = topo
         .edges
         .iter()
@@ -668,9 +952,76 @@ fn snap_surfaces(
         .collect();
     adjacent.sort_unstable();
     adjacent.dedup();
-    let mut snapped = surfaces.to_vec();
-    let snaps = snap::snap(&mut snapped, &adjacent, &stats, size);
-    (snapped, snaps)
+    adjacent
+}
+
+/// The signed angle that the points turn through about the axis (`center`, unit `axis`;
+/// `ref_dir` unit and perpendicular to it), counter-clockwise positive.
+fn turning(
+    center: Point3,
+    axis: Point3,
+    ref_dir: Point3,
+    points: impl Iterator<Item = Point3>,
+) -> f64 {
+    let other = cross(axis, ref_dir);
+    let mut total = 0.0;
+    let mut last: Option<f64> = None;
+    for p in points {
+        let v = sub(p, center);
+        let a = dot(v, other).atan2(dot(v, ref_dir));
+        if let Some(l) = last {
+            let mut d = a - l;
+            if d > std::f64::consts::PI {
+                d -= std::f64::consts::TAU;
+            } else if d < -std::f64::consts::PI {
+                d += std::f64::consts::TAU;
+            }
+            total += d;
+        }
+        last = Some(a);
+    }
+    total
+}
+
+/// The number of groups of faces joined by edges.
+fn shells(nf: usize, edges: &[BrepEdge]) -> usize {
+    let mut parent: Vec<usize> = (0..nf).collect();
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    for e in edges {
+        if let [Some(a), Some(b)] = e.faces {
+            let (a, b) = (find(&mut parent, a), find(&mut parent, b));
+            parent[a.max(b)] = a.min(b);
+        }
+    }
+    (0..nf).filter(|&f| find(&mut parent, f) == f).count()
+}
+
+/// `faces` without those left with no loop, and `edges` with their face indices renumbered.
+fn drop_empty_faces(
+    faces: Vec<BrepFace>,
+    mut edges: Vec<BrepEdge>,
+) -> (Vec<BrepFace>, Vec<BrepEdge>) {
+    if faces.iter().all(|f| !f.loops.is_empty()) {
+        return (faces, edges);
+    }
+    let mut new_id = vec![None; faces.len()];
+    let mut kept = Vec::with_capacity(faces.len());
+    for (i, f) in faces.into_iter().enumerate() {
+        if !f.loops.is_empty() {
+            new_id[i] = Some(kept.len());
+            kept.push(f);
+        }
+    }
+    for e in &mut edges {
+        e.faces = e.faces.map(|f| f.and_then(|f| new_id[f]));
+    }
+    (kept, edges)
 }
 
 /// Per B-rep vertex: the surfaces that meet there (`edge_surfaces` of each incident edge), and
@@ -694,7 +1045,10 @@ fn solve_vertices(
         .vertices
         .iter()
         .zip(&at_vertex)
-        .map(|(&mv, surfs)| intersect::on_surfaces(surfs, pos(mv)))
+        .map(|(&mv, surfs)| {
+            intersect::contact_point(surfs)
+                .unwrap_or_else(|| intersect::on_surfaces(surfs, pos(mv)))
+        })
         .collect();
     (at_vertex, vertices)
 }
@@ -760,9 +1114,16 @@ fn thin_chain(pts: &[Point3], spacing: f64) -> Vec<Point3> {
         kept.push(q);
     }
     let end = pts[n - 1];
-    // The last kept point too close to the end (or past it) gives way to the end.
-    if kept.len() > 1 && dist(kept[kept.len() - 1], end) < 0.5 * spacing {
-        kept.pop();
+    // Kept points too close to the end, or past it (the step to the end turns back), give
+    // way to the end: a spline through them would hook.
+    while kept.len() > 1 {
+        let last = kept[kept.len() - 1];
+        let before = sub(last, kept[kept.len() - 2]);
+        if dist(last, end) < 0.5 * spacing || dot(before, sub(end, last)) <= 0.0 {
+            kept.pop();
+        } else {
+            break;
+        }
     }
     kept.push(end);
     kept

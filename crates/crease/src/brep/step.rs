@@ -10,7 +10,7 @@
 use std::fmt::Write as _;
 
 use super::{Brep, Curve};
-use crate::geometry::vec3::{cross, dot, normalize, scale, sub};
+use crate::geometry::vec3::{dot, normalize, scale, sub};
 use crate::geometry::{Point3, SurfaceParams};
 
 /// The length unit declared in the file (the coordinates are written as they are).
@@ -343,12 +343,6 @@ pub fn to_step(brep: &Brep, name: &str, unit: LengthUnit, uncertainty: f64) -> S
     }
     out.push_str("ENDSEC;\nEND-ISO-10303-21;\n");
     out
-}
-
-/// The direction in which a circle about `axis` through `ref_dir` runs at `p` (the tangent of
-/// increasing parameter).
-pub(crate) fn circle_tangent(center: Point3, axis: Point3, p: Point3) -> Point3 {
-    cross(axis, sub(p, center))
 }
 
 #[cfg(test)]
