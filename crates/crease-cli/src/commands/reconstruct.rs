@@ -21,7 +21,7 @@ use crate::ui::{usage, Stage};
 #[derive(Args, Debug)]
 pub struct ReconstructArgs {
     /// The part: a triangle mesh (.ply .obj .off .stl; oriented and 2-manifold) or a point
-    /// cloud (any format crease reads; normals are estimated).
+    /// cloud (any format crease reads; its normals are used when it has them, else estimated).
     pub input: PathBuf,
     /// Output STEP file (.step or .stp).
     #[arg(short, long)]
@@ -47,6 +47,9 @@ pub struct ReconstructArgs {
         default_value_t = 8.0
     )]
     pub th_norm: f64,
+    /// Clouds: estimate normals (PCA + orientation) even when the file has some.
+    #[arg(long)]
+    pub estimate_normals: bool,
 }
 
 pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
@@ -88,7 +91,15 @@ pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
             ..Default::default()
         };
         let positions = std::mem::take(&mut geom.points.positions);
-        (reconstruct_points(&positions, analysis), positions)
+        let normals = if a.estimate_normals {
+            None
+        } else {
+            geom.points.normals.take()
+        };
+        (
+            reconstruct_points(&positions, normals.as_deref(), analysis),
+            positions,
+        )
     };
     let (rec, positions) = positions;
     let rec = rec.with_context(|| format!("cannot build a B-rep of {}", a.input.display()))?;

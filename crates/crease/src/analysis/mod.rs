@@ -117,6 +117,7 @@ pub struct CloudAnalysis {
     noise: OnceLock<f64>,
     normals: OnceLock<Vec<Point3>>,
     segmentation: OnceLock<PointSegmentation>,
+    normals_given: bool,
     counters: Counters,
 }
 
@@ -152,8 +153,46 @@ impl CloudAnalysis {
             noise: OnceLock::new(),
             normals: OnceLock::new(),
             segmentation: OnceLock::new(),
+            normals_given: false,
             counters: Counters::default(),
         })
+    }
+
+    /// An analysis of `points` whose normals are given (input order, one per point; scaled
+    /// to unit length) rather than estimated: a scanner's, or a CAD sampler's.
+    ///
+    /// Errors: those of [`CloudAnalysis::new`]; a normal count other than the point count; a
+    /// zero or non-finite normal (named by its index).
+    pub fn with_normals(
+        points: &[Point3],
+        normals: &[Point3],
+        params: AnalysisParams,
+    ) -> Result<CloudAnalysis> {
+        if normals.len() != points.len() {
+            return Err(Error::InvalidInput(format!(
+                "{} normals for {} points",
+                normals.len(),
+                points.len()
+            )));
+        }
+        let mut a = CloudAnalysis::new(points, params)?;
+        let sorted: Vec<Option<Point3>> = a
+            .order
+            .par_iter()
+            .map(|&i| crate::geometry::vec3::normalize(normals[i as usize]))
+            .collect();
+        let mut unit = Vec::with_capacity(sorted.len());
+        for (r, n) in sorted.into_iter().enumerate() {
+            unit.push(n.ok_or_else(|| {
+                Error::InvalidInput(format!(
+                    "the normal of point {} is zero or not finite",
+                    a.order[r]
+                ))
+            })?);
+        }
+        a.normals = OnceLock::from(unit);
+        a.normals_given = true;
+        Ok(a)
     }
 
     /// The settings.
@@ -196,8 +235,9 @@ impl CloudAnalysis {
         .copied()
     }
 
-    /// Consistently oriented PCA normals of the (sorted) points, as the segmentation estimates
-    /// them ([`crate::segment::estimated_normals`]).
+    /// The (sorted) points' normals: the given ones ([`CloudAnalysis::with_normals`]), or
+    /// consistently oriented PCA normals as the segmentation estimates them
+    /// ([`crate::segment::estimated_normals`]).
     pub fn normals(&self) -> Result<&[Point3]> {
         let nbrs = self.neighbours()?;
         once(&self.normals, &self.counters.normals, || {
@@ -218,7 +258,7 @@ impl CloudAnalysis {
                 &self.points,
                 nbrs,
                 normals,
-                false,
+                self.normals_given,
                 &self.params.segment,
                 &self.params.points,
             )

@@ -87,6 +87,62 @@ pub(crate) fn on_surfaces(surfaces: &[SurfaceParams], start: Point3) -> Point3 {
     x
 }
 
+/// Points along the intersection curve of `a` and `b` from `start` to `end` (equal for a
+/// closed curve), about `step` apart: each step goes along the curve's tangent (the cross
+/// product of the two normals) and is pulled back onto both surfaces ([`on_surfaces`]); the
+/// direction is the one the mesh chain `guide` (from start to end) sets off in. Marching gives
+/// evenly spaced points exactly on the curve where the chain of a noisy or coarse mesh
+/// zigzags about it. None when the march does not reach the end within twice the guide's
+/// length (the surfaces turn tangent or part, or the march took another branch).
+pub(crate) fn march(
+    a: &SurfaceParams,
+    b: &SurfaceParams,
+    start: Point3,
+    end: Point3,
+    guide: &[Point3],
+    step: f64,
+) -> Option<Vec<Point3>> {
+    let both = [*a, *b];
+    let tangent = |x: Point3| normalize(cross(surface_normal(a, x), surface_normal(b, x)));
+    let length: f64 = guide.windows(2).map(|w| dist(w[0], w[1])).sum();
+    if step.is_nan() || step <= 0.0 || length <= 2.0 * step {
+        return None;
+    }
+    // The way the chain sets off: towards its first point two steps away.
+    let ahead = guide.iter().find(|&&g| dist(g, start) > 2.0 * step)?;
+    let mut t = tangent(start)?;
+    if dot(t, sub(*ahead, start)) < 0.0 {
+        t = scale(t, -1.0);
+    }
+    let mut points = vec![start];
+    let mut x = start;
+    let mut travelled = 0.0;
+    while travelled <= 2.0 * length {
+        let next = on_surfaces(&both, add(x, scale(t, step)));
+        let moved = dist(next, x);
+        if !(moved > 0.3 * step && moved < 3.0 * step) {
+            return None;
+        }
+        // The end within this step (not the start of a closed curve as it sets off).
+        if travelled > 1.5 * step && dist(end, next) <= step {
+            let past = dot(sub(end, x), sub(next, x)) < dot(sub(next, x), sub(next, x));
+            if !past && dist(end, next) > 0.5 * step {
+                points.push(next);
+            }
+            points.push(end);
+            return Some(points);
+        }
+        travelled += moved;
+        let mut nt = tangent(next)?;
+        if dot(nt, t) < 0.0 {
+            nt = scale(nt, -1.0);
+        }
+        points.push(next);
+        (x, t) = (next, nt);
+    }
+    None
+}
+
 /// Where a plane and a ball among `surfaces` touch, if they do (to round-off, as snapping
 /// leaves a ball tangent to its faces): the vertex where a corner ball meets a face and its
 /// fillets. All the surfaces there share one normal, so their distances alone leave the point

@@ -438,8 +438,14 @@ fn build(
                     pts.push(intersect::on_surfaces(&surfs, pos(v)));
                 }
                 pts.push(p1);
-                if surfs.len() >= 2 {
-                    (spline_on(&surfs, thin_chain(&pts, spacing), spacing), true)
+                if let [a, b] = surfs[..] {
+                    // March along the exact intersection where the chain leads; the chain's
+                    // own points, thinned, where the march fails.
+                    let length: f64 = pts.windows(2).map(|w| dist(w[0], w[1])).sum();
+                    let step = length / (length / spacing).clamp(16.0, 200.0);
+                    let along = intersect::march(&a, &b, p0, p1, &pts, step)
+                        .unwrap_or_else(|| thin_chain(&pts, spacing));
+                    (spline_on(&surfs, along, spacing), true)
                 } else {
                     (Curve::polyline(pts), true)
                 }
@@ -832,13 +838,17 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
     Ok(rec)
 }
 
-/// The B-rep of a point cloud (input order, any order): [`reconstruct_cloud`] on a new
-/// analysis with `params`.
+/// The B-rep of a point cloud (any order) with its normals when it has them (else they are
+/// estimated): [`reconstruct_cloud`] on a new analysis with `params`.
 pub fn reconstruct_points(
     points: &[Point3],
+    normals: Option<&[Point3]>,
     params: crate::analysis::AnalysisParams,
 ) -> Result<Reconstruction> {
-    let analysis = crate::analysis::CloudAnalysis::new(points, params)?;
+    let analysis = match normals {
+        Some(n) => crate::analysis::CloudAnalysis::with_normals(points, n, params)?,
+        None => crate::analysis::CloudAnalysis::new(points, params)?,
+    };
     reconstruct_cloud(&analysis)
 }
 
@@ -1114,12 +1124,13 @@ fn thin_chain(pts: &[Point3], spacing: f64) -> Vec<Point3> {
         kept.push(q);
     }
     let end = pts[n - 1];
-    // Kept points too close to the end, or past it (the step to the end turns back), give
-    // way to the end: a spline through them would hook.
+    // Kept points too close to the end, or just past it (the step to the end turns back),
+    // give way to the end: a spline through them would hook.
     while kept.len() > 1 {
         let last = kept[kept.len() - 1];
         let before = sub(last, kept[kept.len() - 2]);
-        if dist(last, end) < 0.5 * spacing || dot(before, sub(end, last)) <= 0.0 {
+        let near = dist(last, end);
+        if near < 0.5 * spacing || (near < 2.0 * spacing && dot(before, sub(end, last)) <= 0.0) {
             kept.pop();
         } else {
             break;
