@@ -296,6 +296,9 @@ struct Fit {
     stats: Vec<snap::FaceStats>,
     /// RMS distance of every assigned point to its surface.
     rms: f64,
+    /// How far from its plane a border chain may stray (RMS) and still be taken as planar, in
+    /// mean mesh edges: the rim of a cloud's envelope is ragged by about half a grid cell.
+    border_flatness: f64,
 }
 
 /// [`brep_from_mesh`], with the residuals measured on `fit` when given (else on the mesh).
@@ -355,6 +358,8 @@ fn build(
     // ends merged, and the merged vertices solved again.
     let (mut at_vertex, mut vertices) = solve_vertices(&topo, &edge_surfaces, &pos);
     let spacing = crate::geometry::cleanup::mean_edge_length(&mesh.vertices.positions, &mesh.faces);
+    // A mesh's planar border is planar to a tenth of an edge.
+    let border_flatness = fit.map_or(0.1, |f| f.border_flatness);
     let tol = 0.1 * spacing;
     let drop: Vec<bool> = topo
         .edges
@@ -404,7 +409,7 @@ fn build(
             [a, b] => intersect::analytic_curve(a, b, p0, p1, size),
             // A border that lies in a plane (a tube cut square, a scan's planar rim): the
             // surface's intersection with that plane.
-            [a] => border_plane(&e.chain, &pos, spacing)
+            [a] => border_plane(&e.chain, &pos, border_flatness * spacing)
                 .and_then(|plane| intersect::analytic_curve(a, &plane, p0, p1, size))
                 .or_else(|| border_line(a, &e.chain, &pos, p0, p1, spacing)),
             _ => None,
@@ -792,6 +797,30 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
             }
         })
         .collect();
+    // A sheet (an open surface, a single-view scan): the envelope's front only.
+    let normals = analysis.normals()?;
+    let front = envelope::front_side(&env.mesh, points, normals, &index);
+    let sheet = front.is_some();
+    let (mesh, face_labels) = match front {
+        Some(keep) => {
+            let faces: Vec<[u32; 3]> = env
+                .mesh
+                .faces
+                .iter()
+                .zip(&keep)
+                .filter(|(_, &k)| k)
+                .map(|(f, _)| *f)
+                .collect();
+            let labels: Vec<i32> = face_labels
+                .iter()
+                .zip(&keep)
+                .filter(|(_, &k)| k)
+                .map(|(l, _)| *l)
+                .collect();
+            (compact(&env.mesh.vertices.positions, faces)?, labels)
+        }
+        None => (env.mesh, face_labels),
+    };
     // Residuals, extents, areas and centroids on the points.
     let ns = surfaces.len();
     let (mut sq, mut count, mut area) = (vec![0.0; ns], vec![0usize; ns], vec![0.0; ns]);
@@ -824,8 +853,28 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
             })
             .collect(),
         rms: (sq.iter().sum::<f64>() / count.iter().sum::<usize>().max(1) as f64).sqrt(),
+        border_flatness: 0.5,
     };
-    let mut rec = build(&env.mesh, &face_labels, &surfaces, Some(&fit))?;
+    let mut rec = build(&mesh, &face_labels, &surfaces, Some(&fit))?;
+    // The border of a sheet follows the envelope's ragged rim: exact on a plane, but a
+    // polyline across a curved surface leaves it between its points.
+    if sheet {
+        let curved_rim = rec.brep.edges.iter().any(|e| {
+            matches!(e.curve, Curve::BSpline { degree: 1, .. })
+                && e.faces
+                    .iter()
+                    .flatten()
+                    .any(|&f| !matches!(rec.brep.faces[f].surface, SurfaceParams::Plane { .. }))
+        });
+        if curved_rim {
+            return Err(Error::InvalidInput(
+                "reconstruct: the cloud is an open sheet (a single-view scan or an open surface) \
+                 whose border crosses a curved surface; open shells from clouds are built only \
+                 where the border runs over planes in this version"
+                    .into(),
+            ));
+        }
+    }
     rec.report.snaps.splice(0..0, merges);
     rec.report.noise_ratio = analysis.noise_ratio()?;
     rec.report.segmentation = "points";
@@ -836,6 +885,31 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
         ));
     }
     Ok(rec)
+}
+
+/// The mesh of `faces` over only the vertices they use (in their order).
+fn compact(positions: &[Point3], faces: Vec<[u32; 3]>) -> Result<TriMesh> {
+    let mut new_id = vec![u32::MAX; positions.len()];
+    let mut kept = Vec::new();
+    for f in &faces {
+        for &v in f {
+            if new_id[v as usize] == u32::MAX {
+                new_id[v as usize] = 0;
+                kept.push(v);
+            }
+        }
+    }
+    kept.sort_unstable();
+    for (i, &v) in kept.iter().enumerate() {
+        new_id[v as usize] = i as u32;
+    }
+    TriMesh::new(
+        kept.iter().map(|&v| positions[v as usize]).collect(),
+        faces
+            .iter()
+            .map(|f| f.map(|v| new_id[v as usize]))
+            .collect(),
+    )
 }
 
 /// The B-rep of a point cloud (any order) with its normals when it has them (else they are
@@ -1063,17 +1137,20 @@ fn solve_vertices(
     (at_vertex, vertices)
 }
 
-/// The plane of a border chain, when its mesh vertices lie in one within a tenth of the mesh
-/// spacing (RMS).
-fn border_plane(chain: &[u32], pos: &dyn Fn(u32) -> Point3, spacing: f64) -> Option<SurfaceParams> {
+/// The plane of a border chain, when its mesh vertices lie in one within `tolerance` (RMS).
+fn border_plane(
+    chain: &[u32],
+    pos: &dyn Fn(u32) -> Point3,
+    tolerance: f64,
+) -> Option<SurfaceParams> {
     if chain.len() < 4 {
         return None;
     }
     let plane = crate::geometry::fit_plane(chain.iter().map(|&v| (pos(v), 1.0)))?;
     let rms = plane.eigenvalues[0].max(0.0).sqrt();
-    let flat = rms <= 0.1 * spacing;
+    let flat = rms <= tolerance;
     // A straight border (a line: two vanishing eigenvalues) has no plane of its own.
-    let straight = plane.eigenvalues[1].max(0.0).sqrt() <= 0.1 * spacing;
+    let straight = plane.eigenvalues[1].max(0.0).sqrt() <= tolerance;
     if !flat || straight {
         return None;
     }
