@@ -238,12 +238,7 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
     let rec = crease::brep::reconstruct_mesh(&m.mesh, &Default::default())?;
     crate::ui::write_text(
         &dir.join("part.step"),
-        &crease::brep::to_step(
-            &rec.brep,
-            "demo-part",
-            crease::brep::LengthUnit::Millimetre,
-            (2.0 * rec.report.max_gap).max(1e-9),
-        ),
+        &rec.to_step("demo-part", crease::brep::LengthUnit::Millimetre, 1.0),
     )?;
     time("brep", s);
 

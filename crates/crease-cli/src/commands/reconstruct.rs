@@ -10,7 +10,7 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use crease::analysis::AnalysisParams;
-use crease::brep::{reconstruct_mesh, reconstruct_points, to_step, LengthUnit};
+use crease::brep::{reconstruct_mesh, reconstruct_points, LengthUnit};
 use crease::geometry::TriMesh;
 use crease::segment::SegmentParams;
 
@@ -114,8 +114,8 @@ pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
     let size = crease::Aabb::from_points(&positions)
         .map(|b| b.diagonal())
         .unwrap_or(1.0);
-    let uncertainty = (2.0 * rec.report.max_gap).max(1e-9 * size);
-    let text = to_step(&rec.brep, &name, a.units, uncertainty);
+    let uncertainty = rec.uncertainty(size);
+    let text = rec.to_step(&name, a.units, size);
     crate::ui::write_text(&a.output, &text)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
     if let Some(p) = &a.topology {

@@ -11,6 +11,7 @@
 //! | `labels.ply` | the points with `sharp`, `sharpness`, `surface`, `surface_type`, `fillet_label`, `smooth_edge` (input order) | the mesh with per-face `surface`, `surface_type` and an `edge` element with `sharp`, `sharpness` |
 //! | `network.obj` | sharp and fillet polylines (OBJ groups `sharp`, `smooth`) | the feature-edge polylines (group `sharp`) |
 //! | `surfaces.json` | the surfaces with their parameters | the same |
+//! | `part.step` | the B-rep (`crease::brep::reconstruct_cloud` on the same analysis), when the surfaces close; otherwise the summary says why | not yet (`crease reconstruct`) |
 //! | `summary.json` | counts, per-stage times, how often each shared piece was computed | the same |
 //! | `picture.png` | the points coloured by surface, the network on top | the mesh coloured by surface, the edges on top |
 
@@ -20,6 +21,7 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use crease::analysis::{AnalysisParams, CloudAnalysis};
+use crease::brep::{reconstruct_cloud, LengthUnit};
 use crease::fillets::{curve_network, extract_fillets_from, FilletParams, Label};
 use crease::geometry::{names, Attribute, PointCloud, ScalarKind, TriMesh};
 use crease::io::Geometry;
@@ -68,6 +70,7 @@ pub fn run(g: &Global, a: &RunArgs) -> anyhow::Result<()> {
         "surfaces.json",
         "summary.json",
         "picture.png",
+        "part.step",
     ] {
         crate::ui::ensure_not_input(&a.output.join(name), &[&a.input])?;
     }
@@ -159,6 +162,38 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     super::save(g, &a.output.join("network.obj"), &net, false, &[&a.input])?;
     write_surfaces(&a.output, &seg.surfaces, &seg.groups, seg.mean_edge)?;
 
+    // The B-rep from the same analysis; a part it cannot close is reported, not fatal (the
+    // other outputs stand).
+    let s = Stage::start("B-rep (STEP)", g.quiet);
+    let brep = match reconstruct_cloud(&analysis) {
+        Ok(rec) => {
+            let size = crease::Aabb::from_points(points)
+                .map(|b| b.diagonal())
+                .unwrap_or(1.0);
+            let stem = a
+                .input
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "part".into());
+            crate::ui::write_text(
+                &a.output.join("part.step"),
+                &rec.to_step(&stem, LengthUnit::Millimetre, size),
+            )
+            .with_context(|| format!("cannot write {}", a.output.join("part.step").display()))?;
+            serde_json::json!({
+                "solid": rec.report.closed,
+                "faces": rec.brep.faces.len(),
+                "edges": rec.brep.edges.len(),
+                "report": rec.report,
+            })
+        }
+        Err(e) => {
+            tracing::warn!("{name}: no B-rep: {e}");
+            serde_json::json!({ "error": e.to_string() })
+        }
+    };
+    timed("brep", s);
+
     let sharp_lines = network.smooth.iter().filter(|&&s| !s).count();
     let smooth_lines = network.polylines.len() - sharp_lines;
     if !a.no_picture {
@@ -184,6 +219,7 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
         "joined_smooth_ends": network.joined_ends,
         "open_smooth_ends": network.open_ends,
         "analysis": analysis.counts(),
+        "brep": brep,
         "timings": timings,
         "segmentation_stages": seg.timings.iter().map(|(k, v)| (k.to_string(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
         "sharp_surface_stage": sharp.surfaces,

@@ -490,6 +490,16 @@ fn run_on_a_cloud_shares_one_analysis_and_writes_every_result() {
         "{sharp_lines} sharp polylines"
     );
     assert_eq!(smooth_lines, 2, "the fillet's two borders");
+    // The B-rep, from the same analysis (the counts above): a solid of the part's 10 faces,
+    // which OpenCASCADE reads as valid with the exact faces.
+    assert_eq!(s["brep"]["solid"], true, "{}", s["brep"]);
+    assert_eq!(
+        s["brep"]["report"]["faces_by_type"],
+        serde_json::json!({"cone": 1, "cylinder": 1, "plane": 8})
+    );
+    let occ = crate::reconstruct_cli::check(&out.join("part.step"), None);
+    assert_eq!(occ["valid"], true, "{occ}");
+    assert_eq!(occ["solids"], 1, "{occ}");
     let png = std::fs::read(out.join("picture.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
 }

@@ -31,7 +31,7 @@ fn occ_python() -> PathBuf {
 }
 
 /// OpenCASCADE's reading of `step` (with the distances of every `every`-th point of `xyz`).
-fn check(step: &Path, points: Option<(&Path, usize)>) -> serde_json::Value {
+pub(crate) fn check(step: &Path, points: Option<(&Path, usize)>) -> serde_json::Value {
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scripts/check_step.py");
     let mut cmd = Process::new(occ_python());
     cmd.arg(script).arg(step);

@@ -276,6 +276,20 @@ pub struct Reconstruction {
     pub report: BrepReport,
 }
 
+impl Reconstruction {
+    /// The STEP file of the B-rep (see [`to_step`]) named `name`, in `unit`, with the
+    /// uncertainty a kernel needs to close its gaps: twice the largest gap, and never below
+    /// the round-off of coordinates of a part of diagonal `size`.
+    pub fn to_step(&self, name: &str, unit: LengthUnit, size: f64) -> String {
+        to_step(&self.brep, name, unit, self.uncertainty(size))
+    }
+
+    /// The uncertainty [`Reconstruction::to_step`] writes.
+    pub fn uncertainty(&self, size: f64) -> f64 {
+        (2.0 * self.report.max_gap).max(1e-9 * size)
+    }
+}
+
 /// The B-rep of `mesh`, whose triangle `t` lies on `surfaces[face_surface[t]]` (negative:
 /// unassigned; such triangles join the nearest region). See the module documentation.
 ///
