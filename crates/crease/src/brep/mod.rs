@@ -7,23 +7,33 @@
 //!    islands of a surface inside another region are absorbed;
 //! 2. snapping ([`snap`]): regions their neighbours explain as well dissolved into them, then
 //!    planes made parallel or perpendicular, axes made a plane's normal or parallel to it,
-//!    coaxial surfaces put on one axis, each within the measured noise and reported;
+//!    coaxial surfaces put on one axis, fillets made tangent to their faces, each within the
+//!    measured noise and reported;
 //! 3. vertices (`intersect::on_surfaces`): solved from the surfaces that meet there, by
-//!    Gauss–Newton from the mesh vertex, not taken from the (noisy) mesh; edges whose two ends
-//!    then coincide (faces touching in a point) are collapsed;
+//!    Levenberg–Marquardt from the mesh vertex (where a ball touches a face: the contact
+//!    point), not taken from the (noisy) mesh; edges whose two ends then coincide (faces
+//!    touching in a point) are collapsed;
 //! 4. edges (`intersect::analytic_curve`): the exact intersection line or circle of the two
-//!    faces' surfaces where the pair has one, otherwise a cubic B-spline through the chain's
-//!    vertices moved onto both surfaces, refined until it stays on them;
+//!    faces' surfaces where the pair has one, otherwise a cubic B-spline through points
+//!    marched along the exact intersection (`intersect::march`) where the chain leads,
+//!    refined until it stays on both surfaces;
 //! 5. faces: the analytic surface, oriented like the mesh (outward on a closed part), bounded
 //!    by the loops of oriented edges, its seam placed off its boundary;
-//! 6. a check: a vertex or an edge farther than [`MAX_GAP`] mesh edges from one of its
-//!    surfaces refuses the part (the surfaces found do not meet) rather than give an invalid
-//!    B-rep;
+//! 6. checks: a vertex or an edge farther than [`MAX_GAP`] mesh edges from one of its
+//!    surfaces, a vertex solved more than [`MAX_MOVE`] mesh edges from its mesh vertex, or
+//!    faces falling into separate shells refuse the part (the surfaces found do not meet where
+//!    the regions do) rather than give an invalid B-rep;
 //! 7. output ([`step`]): a `MANIFOLD_SOLID_BREP` when every edge has a face on both sides, an
 //!    `OPEN_SHELL` (with a warning naming the border) otherwise.
 //!
-//! Not yet done (issue "scan to CAD"): point clouds; an open shell instead of a refusal when
-//! some surfaces do not meet; tangent fillets snapped to their neighbours; ellipses for oblique
+//! A point cloud ([`reconstruct_cloud`]) goes through the shared analysis (its segmentation)
+//! and its envelope (`envelope`: the closed surface of the cloud dilated by a few spacings),
+//! whose triangles take the surfaces of the nearest samples and play the mesh's part; the
+//! residuals and tolerances are measured on the points. An open cloud (a sheet) keeps the front
+//! of its envelope.
+//!
+//! Not yet done (issue "scan to CAD"): an open shell instead of a refusal when some surfaces do
+//! not meet; open clouds whose border crosses a curved surface (refused); ellipses for oblique
 //! plane–cylinder edges; a whole sphere or torus as one face with a seam edge (two faces
 //! today). The border of an open shell is the surface's curve in the border's plane when the
 //! border is planar (a tube's circular ends), a line where it is straight on a plane, and the
