@@ -488,44 +488,42 @@ fn point_clouds_become_valid_solids_with_their_faces_and_volumes() {
 }
 
 #[test]
-fn an_open_cloud_is_an_open_shell_on_planes_and_refused_across_curved_borders() {
+fn open_clouds_become_open_shells_bounded_where_the_samples_end() {
     let dir = tempfile::tempdir().expect("temp dir");
-    // A square sheet: one plane face bounded where the samples end (the envelope's rim, a
-    // few spacings out), every sample on it.
-    for noise in ["0", "0.5"] {
-        let cloud = synth(
-            dir.path(),
-            &["synth", "plane", "-n", "20000", "--noise", noise],
-            &format!("plane-{noise}.xyz"),
-        );
-        let step = dir.path().join(format!("plane-{noise}.step"));
-        let (code, err) = reconstruct_status(&cloud, &step);
-        assert_eq!(code, Some(0), "{err}");
-        assert!(err.contains("open shell"), "{err}");
-        let occ = check(&step, Some((&cloud, 10)));
-        assert_eq!(occ["valid"], true, "{occ}");
-        assert_eq!(occ["solids"], 0, "{occ}");
-        assert_eq!(faces(&occ), vec![("plane".to_string(), 1)], "{occ}");
-        // The unit square, widened by the rim: at most 10 % larger.
-        let area = occ["area"].as_f64().expect("area");
-        assert!(area > 1.0 && area < 1.1, "plane {noise}: area {area}");
-        let far = occ["max_distance"].as_f64().expect("distances");
-        let bound = if noise == "0" { 1e-9 } else { 0.05 };
-        assert!(far < bound, "plane {noise}: a sample {far} from the face");
+    // A square sheet, a tube and a cone, each one face bounded where the samples end (the
+    // envelope's rim, a few spacings out): the tube's and the cone's ends exact circles.
+    let pi = std::f64::consts::PI;
+    for (shape, kind, area, circles) in [
+        ("plane", "plane", 1.0, 0),
+        ("cylinder", "cylinder", pi, 2),
+        ("cone", "cone", 1.3169, 2),
+    ] {
+        for noise in ["0", "0.5"] {
+            let cloud = synth(
+                dir.path(),
+                &["synth", shape, "-n", "20000", "--noise", noise],
+                &format!("{shape}-{noise}.xyz"),
+            );
+            let step = dir.path().join(format!("{shape}-{noise}.step"));
+            let summary = reconstruct(&cloud, &step);
+            assert_eq!(summary["solid"], false, "{shape} {noise}");
+            let got = summary["report"]["edges_by_curve"]["circle"]
+                .as_u64()
+                .unwrap_or(0);
+            assert_eq!(got, circles, "{shape} {noise}: {summary}");
+            let occ = check(&step, Some((&cloud, 10)));
+            assert_eq!(occ["valid"], true, "{shape} {noise}: {occ}");
+            assert_eq!(occ["solids"], 0, "{occ}");
+            assert_eq!(faces(&occ), vec![(kind.to_string(), 1)], "{occ}");
+            // The face, widened by the rim: at most 10 % larger.
+            let got = occ["area"].as_f64().expect("area");
+            assert!(
+                got > area && got < 1.1 * area,
+                "{shape} {noise}: area {got} against {area}"
+            );
+            let far = occ["max_distance"].as_f64().expect("distances");
+            let bound = if noise == "0" { 1e-9 } else { 0.05 };
+            assert!(far < bound, "{shape} {noise}: a sample {far} from the face");
+        }
     }
-    // A tube: its rim crosses the cylinder, which this version refuses rather than write a
-    // border off the surface.
-    let cloud = synth(
-        dir.path(),
-        &["synth", "cylinder", "-n", "20000"],
-        "tube.xyz",
-    );
-    let step = dir.path().join("tube.step");
-    let (code, err) = reconstruct_status(&cloud, &step);
-    assert_eq!(code, Some(1), "{err}");
-    assert!(
-        err.contains("tube.xyz") && err.contains("open sheet"),
-        "{err}"
-    );
-    assert!(!step.exists());
 }

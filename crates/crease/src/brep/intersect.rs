@@ -218,6 +218,8 @@ pub(crate) fn analytic_curve(
     let on_axis = PARALLEL.sqrt() * size;
     match (a, b) {
         (SurfaceParams::Plane { normal: n1, .. }, SurfaceParams::Plane { normal: n2, .. }) => {
+            // Parallel planes (a sheet and the plane of its own border) have no line.
+            (!parallel(*n1, *n2)).then_some(())?;
             Some(line_from(start, end, normalize(cross(*n1, *n2))?))
         }
         (SurfaceParams::Plane { normal, .. }, s) | (s, SurfaceParams::Plane { normal, .. }) => {

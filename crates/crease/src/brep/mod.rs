@@ -33,7 +33,8 @@
 //! of its envelope.
 //!
 //! Not yet done (issue "scan to CAD"): an open shell instead of a refusal when some surfaces do
-//! not meet; open clouds whose border crosses a curved surface (refused); ellipses for oblique
+//! not meet; open clouds whose border crosses a curved surface out of a plane (refused);
+//! a cloud's border where the samples end rather than at its envelope's rim; ellipses for oblique
 //! plane–cylinder edges; a whole sphere or torus as one face with a seam edge (two faces
 //! today). The border of an open shell is the surface's curve in the border's plane when the
 //! border is planar (a tube's circular ends), a line where it is straight on a plane, and the
@@ -52,7 +53,7 @@ use serde::Serialize;
 
 use crate::estimate::noise::{noise_ratio, NOISE_K, NOISY_RATIO};
 use crate::geometry::surface::{signed_distance, surface_normal};
-use crate::geometry::vec3::{cross, dist, dot, norm, normalize, sub};
+use crate::geometry::vec3::{cross, dist, dot, norm, normalize, scale, sub};
 use crate::geometry::MeshTopology;
 use crate::geometry::{face_areas, face_normals, Aabb, Point3, SurfaceParams, TriMesh};
 use crate::segment::{neighbours_needed, segment_mesh, segment_points, PointParams, SegmentParams};
@@ -321,7 +322,7 @@ struct Fit {
     /// RMS distance of every assigned point to its surface.
     rms: f64,
     /// How far from its plane a border chain may stray (RMS) and still be taken as planar, in
-    /// mean mesh edges: the rim of a cloud's envelope is ragged by about half a grid cell.
+    /// mean mesh edges: the rim of a cloud's envelope is ragged by about a grid cell.
     border_flatness: f64,
 }
 
@@ -433,7 +434,11 @@ fn build(
             [a, b] => intersect::analytic_curve(a, b, p0, p1, size),
             // A border that lies in a plane (a tube cut square, a scan's planar rim): the
             // surface's intersection with that plane.
-            [a] => border_plane(&e.chain, &pos, border_flatness * spacing)
+            // (A plane's planar border lies in the plane itself.)
+            [a] => (!matches!(a, SurfaceParams::Plane { .. }))
+                .then(|| border_plane(&e.chain, &pos, border_flatness * spacing))
+                .flatten()
+                .map(|plane| square_to_axis(plane, a, &e.chain, &pos, border_flatness * spacing))
                 .and_then(|plane| intersect::analytic_curve(a, &plane, p0, p1, size))
                 .or_else(|| border_line(a, &e.chain, &pos, p0, p1, spacing)),
             _ => None,
@@ -877,7 +882,7 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
             })
             .collect(),
         rms: (sq.iter().sum::<f64>() / count.iter().sum::<usize>().max(1) as f64).sqrt(),
-        border_flatness: 0.5,
+        border_flatness: 1.0,
     };
     let mut rec = build(&mesh, &face_labels, &surfaces, Some(&fit))?;
     // The border of a sheet follows the envelope's ragged rim: exact on a plane, but a
@@ -1182,6 +1187,41 @@ fn border_plane(
         normal: plane.normal,
         offset: dot(plane.normal, plane.centroid),
     })
+}
+
+/// A border's plane made square to the axis of the surface it bounds (a tube cut square) when
+/// its tilt is within what the chain's ragged points (`tolerance`, RMS) cannot resolve over its
+/// extent; through the chain's centroid.
+fn square_to_axis(
+    plane: SurfaceParams,
+    surface: &SurfaceParams,
+    chain: &[u32],
+    pos: &dyn Fn(u32) -> Point3,
+    tolerance: f64,
+) -> SurfaceParams {
+    let (SurfaceParams::Plane { normal, .. }, Some((_, axis))) = (plane, surface.axis()) else {
+        return plane;
+    };
+    let Some(extent) =
+        Aabb::from_points(&chain.iter().map(|&v| pos(v)).collect::<Vec<_>>()).map(|b| b.diagonal())
+    else {
+        return plane;
+    };
+    let c = dot(normal, axis);
+    let tilt = (1.0 - c.abs()).max(0.0);
+    if extent <= 0.0 || tilt > 0.5 * (tolerance / extent).powi(2) {
+        return plane;
+    }
+    let n = if c < 0.0 { scale(axis, -1.0) } else { axis };
+    let m = chain.len() as f64;
+    let centroid = chain.iter().fold([0.0; 3], |acc, &v| {
+        let p = pos(v);
+        [acc[0] + p[0] / m, acc[1] + p[1] / m, acc[2] + p[2] / m]
+    });
+    SurfaceParams::Plane {
+        normal: n,
+        offset: dot(n, centroid),
+    }
 }
 
 /// The line of a straight border chain on a plane (its mesh vertices within a tenth of the mesh
