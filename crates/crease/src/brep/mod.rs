@@ -680,21 +680,7 @@ pub fn reconstruct_mesh(mesh: &TriMesh, params: &SegmentParams) -> Result<Recons
         // PCA normals over 20 neighbours: the noisy mesh's own vertex normals (its one-ring)
         // average too few points.
         let seg = segment_points(positions, None, params, &PointParams::default())?;
-        let v = &seg.point_surface;
-        let labels = mesh
-            .faces
-            .iter()
-            .map(|f| {
-                let [a, b, c] = f.map(|i| v[i as usize]);
-                if a == b || a == c {
-                    a
-                } else if b == c {
-                    b
-                } else {
-                    -1
-                }
-            })
-            .collect();
+        let labels = face_labels_from_vertices(&mesh.faces, &seg.point_surface);
         let surfaces: Vec<SurfaceParams> = seg.surfaces.iter().map(|s| s.params).collect();
         (labels, surfaces, "vertices")
     };
@@ -811,21 +797,7 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
             best.1
         })
         .collect();
-    let face_labels: Vec<i32> = env
-        .mesh
-        .faces
-        .iter()
-        .map(|f| {
-            let [a, b, c] = f.map(|v| vertex_label[v as usize]);
-            if a == b || a == c {
-                a
-            } else if b == c {
-                b
-            } else {
-                -1
-            }
-        })
-        .collect();
+    let face_labels = face_labels_from_vertices(&env.mesh.faces, &vertex_label);
     // A sheet (an open surface, a single-view scan): the envelope's front only.
     let normals = analysis.normals()?;
     let front = envelope::front_side(&env.mesh, points, normals, &index);
@@ -914,6 +886,23 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
         ));
     }
     Ok(rec)
+}
+
+/// Per triangle: the label two or three of its corners share (-1 if none).
+fn face_labels_from_vertices(faces: &[[u32; 3]], vertex_label: &[i32]) -> Vec<i32> {
+    faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|v| vertex_label[v as usize]);
+            if a == b || a == c {
+                a
+            } else if b == c {
+                b
+            } else {
+                -1
+            }
+        })
+        .collect()
 }
 
 /// The mesh of `faces` over only the vertices they use (in their order).
