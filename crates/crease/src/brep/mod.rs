@@ -823,37 +823,17 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
         None => (env.mesh, face_labels),
     };
     // Residuals, extents, areas and centroids on the points.
-    let ns = surfaces.len();
-    let (mut sq, mut count, mut area) = (vec![0.0; ns], vec![0usize; ns], vec![0.0; ns]);
-    let mut sum = vec![[0.0; 3]; ns];
-    let mut boxes: Vec<Option<Aabb>> = vec![None; ns];
-    for ((p, &l), &a) in points.iter().zip(&labels).zip(&seg.point_area) {
-        if let Ok(l) = usize::try_from(l) {
-            sq[l] += signed_distance(&surfaces[l], *p).powi(2);
-            count[l] += 1;
-            area[l] += a;
-            for k in 0..3 {
-                sum[l][k] += p[k];
-            }
-            match &mut boxes[l] {
-                Some(b) => b.grow(*p),
-                None => boxes[l] = Some(Aabb { min: *p, max: *p }),
-            }
-        }
-    }
+    let (stats, rms) = face_stats(
+        &surfaces,
+        points
+            .iter()
+            .zip(&labels)
+            .zip(&seg.point_area)
+            .filter_map(|((p, &l), &a)| usize::try_from(l).ok().map(|l| (l, *p, a))),
+    );
     let fit = Fit {
-        stats: (0..ns)
-            .map(|s| {
-                let c = count[s].max(1) as f64;
-                snap::FaceStats {
-                    rms: (sq[s] / c).sqrt(),
-                    extent: boxes[s].map(|b| b.diagonal()).unwrap_or(0.0),
-                    area: area[s],
-                    centroid: sum[s].map(|x| x / c),
-                }
-            })
-            .collect(),
-        rms: (sq.iter().sum::<f64>() / count.iter().sum::<usize>().max(1) as f64).sqrt(),
+        stats,
+        rms,
         border_flatness: 1.0,
     };
     let mut rec = build(&mesh, &face_labels, &surfaces, Some(&fit))?;
@@ -964,33 +944,53 @@ fn snap_surfaces(
         );
         return (snapped, snaps);
     }
-    let ns = surfaces.len();
     let p = &mesh.vertices.positions;
     let areas = face_areas(mesh);
+    // Each triangle's vertices, its area counted once.
+    let (stats, _) = face_stats(
+        surfaces,
+        mesh.faces.iter().enumerate().flat_map(|(t, f)| {
+            let s = topo.surface_of_region[topo.region_of_face[t] as usize];
+            let area = areas[t];
+            f.iter()
+                .enumerate()
+                .map(move |(i, &v)| (s, p[v as usize], if i == 0 { area } else { 0.0 }))
+        }),
+    );
+    let mut snapped = surfaces.to_vec();
+    let snaps = snap::snap(
+        &mut snapped,
+        &adjacent_surfaces(topo),
+        &touching_surfaces(topo),
+        &stats,
+        size,
+    );
+    (snapped, snaps)
+}
+
+/// Per surface: the RMS distance, extent, area and centroid of its `samples` (surface, point,
+/// area the point stands for); and the RMS distance of them all.
+fn face_stats(
+    surfaces: &[SurfaceParams],
+    samples: impl Iterator<Item = (usize, Point3, f64)>,
+) -> (Vec<snap::FaceStats>, f64) {
+    let ns = surfaces.len();
     let (mut sq, mut count, mut area) = (vec![0.0; ns], vec![0usize; ns], vec![0.0; ns]);
     let mut sum = vec![[0.0; 3]; ns];
     let mut boxes: Vec<Option<Aabb>> = vec![None; ns];
-    for (t, f) in mesh.faces.iter().enumerate() {
-        let s = topo.surface_of_region[topo.region_of_face[t] as usize];
-        area[s] += areas[t];
-        for &v in f {
-            let q = p[v as usize];
-            let d = signed_distance(&surfaces[s], q);
-            sq[s] += d * d;
-            count[s] += 1;
-            for k in 0..3 {
-                sum[s][k] += q[k];
-            }
-            boxes[s] = Some(match boxes[s] {
-                Some(mut b) => {
-                    b.grow(q);
-                    b
-                }
-                None => Aabb { min: q, max: q },
-            });
+    for (s, p, a) in samples {
+        sq[s] += signed_distance(&surfaces[s], p).powi(2);
+        count[s] += 1;
+        area[s] += a;
+        for k in 0..3 {
+            sum[s][k] += p[k];
+        }
+        match &mut boxes[s] {
+            Some(b) => b.grow(p),
+            None => boxes[s] = Some(Aabb { min: p, max: p }),
         }
     }
-    let stats: Vec<snap::FaceStats> = (0..ns)
+    let stats = (0..ns)
         .map(|s| {
             let c = count[s].max(1) as f64;
             snap::FaceStats {
@@ -1001,15 +1001,8 @@ fn snap_surfaces(
             }
         })
         .collect();
-    let mut snapped = surfaces.to_vec();
-    let snaps = snap::snap(
-        &mut snapped,
-        &adjacent_surfaces(topo),
-        &touching_surfaces(topo),
-        &stats,
-        size,
-    );
-    (snapped, snaps)
+    let rms = (sq.iter().sum::<f64>() / count.iter().sum::<usize>().max(1) as f64).sqrt();
+    (stats, rms)
 }
 
 /// The pairs of distinct surfaces whose regions share an edge or a vertex, ascending.
