@@ -491,25 +491,12 @@ fn dilate(band: &[bool], dims: [usize; 3], axis: usize, reach: usize) -> Vec<boo
 /// [`MIN_COMPONENT_FRACTION`] of the largest one's triangles, how many were dropped and how
 /// many kept.
 fn largest_components(nv: usize, faces: Vec<[u32; 3]>) -> (Vec<[u32; 3]>, usize, usize) {
-    let mut parent: Vec<u32> = (0..nv as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            let up = parent[parent[x as usize] as usize];
-            parent[x as usize] = up;
-            x = up;
-        }
-        x
-    }
+    let mut sets = crate::geometry::union_find::UnionFind::new(nv);
     for f in &faces {
-        let a = find(&mut parent, f[0]);
-        for &v in &f[1..] {
-            let b = find(&mut parent, v);
-            if a != b {
-                parent[b as usize] = a;
-            }
-        }
+        sets.union(f[0], f[1]);
+        sets.union(f[0], f[2]);
     }
-    let roots: Vec<u32> = faces.iter().map(|f| find(&mut parent, f[0])).collect();
+    let roots: Vec<u32> = faces.iter().map(|f| sets.find(f[0])).collect();
     let mut count = vec![0usize; nv];
     for &r in &roots {
         count[r as usize] += 1;

@@ -1080,21 +1080,13 @@ fn turning(
 
 /// The number of groups of faces joined by edges.
 fn shells(nf: usize, edges: &[BrepEdge]) -> usize {
-    let mut parent: Vec<usize> = (0..nf).collect();
-    fn find(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
+    let mut sets = crate::geometry::union_find::UnionFind::new(nf);
     for e in edges {
         if let [Some(a), Some(b)] = e.faces {
-            let (a, b) = (find(&mut parent, a), find(&mut parent, b));
-            parent[a.max(b)] = a.min(b);
+            sets.union(a as u32, b as u32);
         }
     }
-    (0..nf).filter(|&f| find(&mut parent, f) == f).count()
+    (0..nf as u32).filter(|&f| sets.find(f) == f).count()
 }
 
 /// `faces` without those left with no loop, and `edges` with their face indices renumbered.

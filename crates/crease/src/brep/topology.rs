@@ -551,21 +551,13 @@ impl Topology {
             })
             .collect();
         let nv = self.vertices.len();
-        let mut parent: Vec<usize> = (0..nv).collect();
-        fn find(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
+        let mut sets = crate::geometry::union_find::UnionFind::new(nv);
         let mut dropped = vec![false; self.edges.len()];
         for (e, edge) in self.edges.iter().enumerate() {
             if !drop[e] || alone[e] {
                 continue;
             }
-            let (a, b) = (find(&mut parent, edge.start), find(&mut parent, edge.end));
-            parent[a.max(b)] = a.min(b);
+            sets.union(edge.start as u32, edge.end as u32);
             dropped[e] = true;
         }
         if !dropped.contains(&true) {
@@ -574,7 +566,7 @@ impl Topology {
         let mut new_vertex = vec![usize::MAX; nv];
         let mut vertices = Vec::new();
         for v in 0..nv {
-            let r = find(&mut parent, v);
+            let r = sets.find(v as u32) as usize;
             if new_vertex[r] == usize::MAX {
                 new_vertex[r] = vertices.len();
                 vertices.push(self.vertices[r]);

@@ -12,6 +12,7 @@ pub mod polyline;
 pub mod surface;
 pub(crate) use point_cloud::retain_by;
 pub mod topology;
+pub(crate) mod union_find;
 pub mod vec3;
 
 pub use aabb::Aabb;

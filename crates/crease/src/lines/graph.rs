@@ -6,6 +6,7 @@
 //! face), so it is a plain adjacency list with sorted rows; every step visits vertices and
 //! edges in a fixed order, so results are deterministic.
 
+use crate::geometry::union_find::UnionFind;
 use rayon::prelude::*;
 
 use crate::geometry::{vec3, Csr, Point3};
@@ -117,35 +118,6 @@ impl ClusterGraph {
             frontier = next;
         }
         None
-    }
-}
-
-/// Union–find over vertex ids (path halving; the smaller root wins, so results are
-/// deterministic), for the spanning forests of steps 4 and the boundary.
-struct UnionFind(Vec<u32>);
-
-impl UnionFind {
-    fn new(n: usize) -> Self {
-        UnionFind((0..n as u32).collect())
-    }
-
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let y = self.0[x as usize];
-            self.0[x as usize] = self.0[y as usize];
-            x = y;
-        }
-        x
-    }
-
-    /// Joins the sets of a and b; false if they were already one.
-    fn union(&mut self, a: u32, b: u32) -> bool {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra == rb {
-            return false;
-        }
-        self.0[ra.max(rb) as usize] = ra.min(rb);
-        true
     }
 }
 
