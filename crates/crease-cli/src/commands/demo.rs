@@ -510,7 +510,8 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
                   "part-mesh.png", "part-detected-sharp.png", "part-lines.obj", "part-lines.png",
                   "part-network.obj", "part-network.png", "part-segments.ply",
                   "part-segments.png", "part.step", "part-edges.obj", "part-edges.png", "run/labels.ply",
-                  "run/network.obj", "run/surfaces.json", "run/summary.json", "run/picture.png"],
+                  "run/network.obj", "run/surfaces.json", "run/part.step", "run/summary.json",
+                  "run/picture.png"],
         "seconds": timings,
     });
     crate::ui::write_text(
