@@ -22,6 +22,8 @@ use rayon::prelude::*;
 
 use crate::geometry::{Point3, TriMesh};
 use crate::spatial::KdIndex;
+
+use super::pieces;
 use crate::{Error, Result};
 
 /// Grid cells along the longest side of the cloud's box, at most: the envelope's resolution
@@ -255,26 +257,7 @@ pub(crate) fn front_side(
     if (ahead.min(n - ahead) as f64) < SHEET_FRACTION * n as f64 {
         return None;
     }
-    // Neighbours across edges (two per edge on the closed envelope).
-    let mut by_edge: Vec<(u32, u32, u32)> = mesh
-        .faces
-        .iter()
-        .enumerate()
-        .flat_map(|(t, f)| {
-            (0..3).map(move |e| {
-                let (a, b) = (f[e], f[(e + 1) % 3]);
-                (a.min(b), a.max(b), t as u32)
-            })
-        })
-        .collect();
-    by_edge.par_sort_unstable();
-    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for w in by_edge.windows(2) {
-        if (w[0].0, w[0].1) == (w[1].0, w[1].1) {
-            neighbours[w[0].2 as usize].push(w[1].2);
-            neighbours[w[1].2 as usize].push(w[0].2);
-        }
-    }
+    let neighbours = pieces::edge_neighbours(mesh);
     // The rim's sides are ragged: three rounds of majority among a triangle and its three
     // neighbours.
     for _ in 0..3 {
@@ -291,101 +274,12 @@ pub(crate) fn front_side(
             .collect();
     }
     // The largest piece of the front, with the holes in it filled (every piece of the back but
-    // the largest), and no vertex where the front pinches (triangles meeting there in two
-    // fans: the smaller fans go).
-    front = largest_piece(&front, &neighbours)?;
+    // the largest), and no vertex where the front pinches.
+    front = pieces::largest_piece(&front, &neighbours)?;
     let back: Vec<bool> = front.iter().map(|&f| !f).collect();
-    let back = largest_piece(&back, &neighbours)?;
+    let back = pieces::largest_piece(&back, &neighbours)?;
     front = back.iter().map(|&b| !b).collect();
-    let mut around: Vec<Vec<u32>> = vec![Vec::new(); mesh.vertices.positions.len()];
-    for (t, f) in mesh.faces.iter().enumerate() {
-        for &v in f {
-            around[v as usize].push(t as u32);
-        }
-    }
-    for _ in 0..4 {
-        let mut changed = false;
-        for (v, tris) in around.iter().enumerate() {
-            let kept: Vec<u32> = tris
-                .iter()
-                .copied()
-                .filter(|&t| front[t as usize])
-                .collect();
-            if kept.len() < 2 {
-                continue;
-            }
-            // Fans: kept triangles about v joined across an edge through v.
-            let mut fan = vec![usize::MAX; kept.len()];
-            let mut sizes = Vec::new();
-            for i in 0..kept.len() {
-                if fan[i] != usize::MAX {
-                    continue;
-                }
-                fan[i] = sizes.len();
-                let mut stack = vec![i];
-                let mut size = 0;
-                while let Some(a) = stack.pop() {
-                    size += 1;
-                    for j in 0..kept.len() {
-                        if fan[j] == usize::MAX && share_edge_at(mesh, kept[a], kept[j], v as u32) {
-                            fan[j] = fan[i];
-                            stack.push(j);
-                        }
-                    }
-                }
-                sizes.push(size);
-            }
-            if sizes.len() > 1 {
-                let big = (0..sizes.len()).max_by_key(|&i| (sizes[i], std::cmp::Reverse(i)))?;
-                for (i, &t) in kept.iter().enumerate() {
-                    if fan[i] != big {
-                        front[t as usize] = false;
-                        changed = true;
-                    }
-                }
-            }
-        }
-        if !changed {
-            break;
-        }
-        front = largest_piece(&front, &neighbours)?;
-    }
-    Some(front)
-}
-
-/// Whether triangles `a` and `b` share an edge through vertex `v`.
-fn share_edge_at(mesh: &TriMesh, a: u32, b: u32, v: u32) -> bool {
-    let (fa, fb) = (mesh.faces[a as usize], mesh.faces[b as usize]);
-    fa.iter().any(|&x| x != v && fb.contains(&x))
-}
-
-/// The largest edge-connected piece of the flagged triangles (ties: the one with the lowest
-/// triangle), or none when no triangle is flagged.
-fn largest_piece(flag: &[bool], neighbours: &[Vec<u32>]) -> Option<Vec<bool>> {
-    let n = flag.len();
-    let mut piece = vec![u32::MAX; n];
-    let mut sizes = Vec::new();
-    for t in 0..n {
-        if !flag[t] || piece[t] != u32::MAX {
-            continue;
-        }
-        let id = sizes.len() as u32;
-        let mut stack = vec![t];
-        piece[t] = id;
-        let mut size = 0usize;
-        while let Some(u) = stack.pop() {
-            size += 1;
-            for &v in &neighbours[u] {
-                if flag[v as usize] && piece[v as usize] == u32::MAX {
-                    piece[v as usize] = id;
-                    stack.push(v as usize);
-                }
-            }
-        }
-        sizes.push(size);
-    }
-    let largest = (0..sizes.len()).max_by_key(|&i| (sizes[i], std::cmp::Reverse(i)))? as u32;
-    Some(piece.iter().map(|&p| p == largest).collect())
+    pieces::manifold_piece(mesh, &front, &neighbours)
 }
 
 /// The axis permutations (a, b, c): the Kuhn tetrahedron of a permutation walks from the cube's

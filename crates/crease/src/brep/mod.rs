@@ -20,9 +20,14 @@
 //! 5. faces: the analytic surface, oriented like the mesh (outward on a closed part), bounded
 //!    by the loops of oriented edges, its seam placed off its boundary;
 //! 6. checks: a vertex or an edge farther than [`MAX_GAP`] mesh edges from one of its
-//!    surfaces, a vertex solved more than [`MAX_MOVE`] mesh edges from its mesh vertex, or
-//!    faces falling into separate shells refuse the part (the surfaces found do not meet where
-//!    the regions do) rather than give an invalid B-rep;
+//!    surfaces, a vertex solved more than [`MAX_MOVE`] mesh edges from its mesh vertex, or a
+//!    face wider than that whose edges all shrink to points: the surfaces found do not meet
+//!    where the regions do (a free-form patch fitted by a cylinder, a surface missed). The
+//!    smallest region at each such place is left out and the rest built again, until it
+//!    builds: an open shell, bounded by the mesh's border where those regions were, each one
+//!    reported (refused when less than [`MIN_EXPLAINED`] of the area would remain).
+//!    Unassigned triangles no surface explains (`explained_triangles`) are left out the same
+//!    way; faces falling into separate shells refuse the part;
 //! 7. output ([`step`]): a `MANIFOLD_SOLID_BREP` when every edge has a face on both sides, an
 //!    `OPEN_SHELL` (with a warning naming the border) otherwise.
 //!
@@ -32,17 +37,19 @@
 //! residuals and tolerances are measured on the points. An open cloud (a sheet) keeps the front
 //! of its envelope.
 //!
-//! Not yet done (issue "scan to CAD"): an open shell instead of a refusal when some surfaces do
-//! not meet; open clouds whose border crosses a curved surface out of a plane (refused);
-//! a cloud's border where the samples end rather than at its envelope's rim; ellipses for oblique
+//! Not yet done (issue "scan to CAD"): a cloud's border where the samples end rather than at
+//! its envelope's rim; faces whose surfaces meet only tangentially or in singular curves (two
+//! equal cylinders crossing: a cross bore) are not always valid; ellipses for oblique
 //! plane–cylinder edges; a whole sphere or torus as one face with a seam edge (two faces
 //! today). The border of an open shell is the surface's curve in the border's plane when the
-//! border is planar (a tube's circular ends), a line where it is straight on a plane, and the
-//! mesh's polyline otherwise. Measured figures:
+//! border is planar (a tube's circular ends), a line where it is straight on a plane, the
+//! mesh's polyline otherwise (for a cloud's ragged envelope rim across a curved surface: the
+//! chain smoothed on the surface, as a spline on it). Measured figures:
 //! `docs/experiments/brep.md`.
 
 pub(crate) mod envelope;
 pub(crate) mod intersect;
+pub(crate) mod pieces;
 pub mod snap;
 pub mod step;
 pub(crate) mod topology;
@@ -276,6 +283,10 @@ pub struct BrepReport {
     pub snaps: Vec<snap::Snap>,
     /// What is missing or approximate, in words.
     pub warnings: Vec<String>,
+    /// Regions left out because their surfaces do not meet their neighbours (an open shell).
+    pub left_out: Vec<LeftOut>,
+    /// The share of the input's area on no surface found, left out (an open shell).
+    pub unexplained: f64,
 }
 
 /// A B-rep and its report.
@@ -311,7 +322,7 @@ pub fn brep_from_mesh(
     face_surface: &[i32],
     surfaces: &[SurfaceParams],
 ) -> Result<Reconstruction> {
-    build(mesh, face_surface, surfaces, None)
+    build_open(mesh, face_surface, surfaces, None)
 }
 
 /// Residuals of the data the surfaces were fitted to, when that is not the mesh the topology
@@ -326,13 +337,281 @@ struct Fit {
     border_flatness: f64,
 }
 
+/// The least fraction of a part's area that must remain for an open shell to be written when
+/// some of its surfaces do not meet their neighbours (see [`brep_from_mesh`]); with less, the
+/// B-rep is refused: the surfaces found are not the part's.
+pub const MIN_EXPLAINED: f64 = 0.5;
+
+/// A region left out of the B-rep because its surface does not meet its neighbours'.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LeftOut {
+    /// Its surface (index into the segmentation's surfaces).
+    pub surface: usize,
+    /// The surface's type.
+    pub kind: &'static str,
+    /// Its share of the input's area.
+    pub area_fraction: f64,
+    /// Its centroid.
+    pub near: Point3,
+}
+
+/// [`build`]; where the surfaces found do not meet where the mesh's regions do (a free-form
+/// patch fitted by a cylinder, a surface missed), the smallest region at each such place is
+/// left out and the rest built again, until the B-rep builds: an open shell bounded by the
+/// mesh's border where the regions were, each one reported. Refused when less than
+/// [`MIN_EXPLAINED`] of the area would remain.
+fn build_open(
+    mesh: &TriMesh,
+    face_surface: &[i32],
+    surfaces: &[SurfaceParams],
+    fit: Option<&Fit>,
+) -> Result<Reconstruction> {
+    let nt = mesh.faces.len();
+    let areas = face_areas(mesh);
+    let total: f64 = areas.iter().sum();
+    // The share of the area of the kept triangles.
+    let share_of = |keep: &[bool]| -> f64 {
+        keep.iter()
+            .zip(&areas)
+            .filter(|(&k, _)| k)
+            .map(|(_, a)| a)
+            .sum::<f64>()
+            / total
+    };
+    let mut keep = vec![true; nt];
+    let mut left_out: Vec<LeftOut> = Vec::new();
+    let mut first: Option<String> = None;
+    let neighbours = pieces::edge_neighbours(mesh);
+    let mut labels_now = face_surface.to_vec();
+    // Unassigned triangles that no surface explains (a free-form patch, a missed surface) are
+    // left out; the rest fill the strips between regions.
+    let mut unexplained = 0.0;
+    if fit.is_none() {
+        let explained = explained_triangles(mesh, face_surface, surfaces, &neighbours);
+        for (t, e) in explained.iter().enumerate() {
+            if !e {
+                keep[t] = false;
+                unexplained += areas[t];
+            }
+        }
+        if unexplained > 0.0 {
+            let remaining = pieces::manifold_piece(mesh, &keep, &neighbours);
+            let share = remaining.as_deref().map_or(0.0, share_of);
+            if share < MIN_EXPLAINED {
+                // (A mesh the topology cannot read says so first.)
+                topology::check(mesh)?;
+                return Err(Error::InvalidInput(format!(
+                    "reconstruct: the surfaces found explain {:.0} % of the part (at least {:.0} % \
+                     is needed for an open shell): free-form, or its surfaces were not all found",
+                    100.0 * share,
+                    100.0 * MIN_EXPLAINED
+                )));
+            }
+            if let Some(r) = remaining {
+                keep = r;
+            }
+            unexplained = total * (1.0 - share_of(&keep));
+        }
+    }
+    loop {
+        let kept: Vec<u32> = (0..nt as u32).filter(|&t| keep[t as usize]).collect();
+        let sub;
+        let (part, labels): (&TriMesh, Vec<i32>) = if kept.len() == nt {
+            (mesh, labels_now.clone())
+        } else {
+            sub = compact(
+                &mesh.vertices.positions,
+                kept.iter().map(|&t| mesh.faces[t as usize]).collect(),
+            )?;
+            (&sub, kept.iter().map(|&t| labels_now[t as usize]).collect())
+        };
+        let refusal = |first: &str, why: String| {
+            Error::InvalidInput(format!(
+                "reconstruct: {first}, so no valid B-rep can be built{why}; the part's surfaces \
+                 were not all found (free-form or too noisy?)"
+            ))
+        };
+        match build(part, &labels, surfaces, fit) {
+            Ok(mut rec) => {
+                if unexplained > 0.0 {
+                    rec.report.warnings.push(format!(
+                        "{:.1} % of the part's area lies on no surface found (free-form, or a \
+                         surface missed): left out, the B-rep is open there",
+                        100.0 * unexplained / total
+                    ));
+                    rec.report.unexplained = unexplained / total;
+                }
+                if !left_out.is_empty() {
+                    let share: f64 = left_out.iter().map(|l| l.area_fraction).sum();
+                    let list: Vec<String> = left_out
+                        .iter()
+                        .map(|l| {
+                            format!(
+                                "a {} near ({:.4}, {:.4}, {:.4}), {:.1} % of the area",
+                                l.kind,
+                                l.near[0],
+                                l.near[1],
+                                l.near[2],
+                                100.0 * l.area_fraction
+                            )
+                        })
+                        .collect();
+                    rec.report.warnings.push(format!(
+                        "{}; left out {} region(s) whose surfaces do not meet their neighbours \
+                         ({:.1} % of the area: {}): the B-rep is open where they were",
+                        first.as_deref().unwrap_or_default(),
+                        left_out.len(),
+                        100.0 * share,
+                        list.join("; ")
+                    ));
+                    rec.report.left_out = left_out;
+                }
+                return Ok(rec);
+            }
+            Err(Failure::Error(e)) => {
+                return Err(match first {
+                    None => e,
+                    Some(first) => refusal(&first, format!(" (and without those surfaces: {e})")),
+                })
+            }
+            Err(Failure::Mismatch {
+                regions,
+                message,
+                labels,
+            }) => {
+                let first = first.get_or_insert(message);
+                for (&t, l) in kept.iter().zip(labels) {
+                    labels_now[t as usize] = l;
+                }
+                for (surface, triangles) in regions {
+                    let (mut area, mut centroid) = (0.0, [0.0; 3]);
+                    for &t in &triangles {
+                        let t = kept[t as usize] as usize;
+                        keep[t] = false;
+                        area += areas[t];
+                        let c = mesh.faces[t].map(|v| mesh.vertices.positions[v as usize]);
+                        for k in 0..3 {
+                            centroid[k] += areas[t] * (c[0][k] + c[1][k] + c[2][k]) / 3.0;
+                        }
+                    }
+                    left_out.push(LeftOut {
+                        surface,
+                        kind: surfaces[surface].kind().name(),
+                        area_fraction: area / total,
+                        near: scale(centroid, 1.0 / area.max(f64::MIN_POSITIVE)),
+                    });
+                }
+                let remaining = pieces::manifold_piece(mesh, &keep, &neighbours);
+                let explained: f64 = remaining.as_deref().map_or(0.0, share_of);
+                if explained < MIN_EXPLAINED {
+                    return Err(refusal(
+                        first,
+                        format!(
+                            " (without the surfaces that do not meet, {:.0} % of the part would \
+                             remain; at least {:.0} % is needed for an open shell)",
+                            100.0 * explained,
+                            100.0 * MIN_EXPLAINED
+                        ),
+                    ));
+                }
+                if let Some(r) = remaining {
+                    keep = r;
+                }
+            }
+        }
+    }
+}
+
+/// Per triangle: whether a surface explains it. Assigned triangles are explained; an
+/// unassigned one is when a neighbouring explained triangle's surface passes within its
+/// longest edge (plus three times the RMS residual of the assigned corners: the noise) of
+/// each of its corners (a triangle straddling the edge between two faces), breadth first from
+/// the assigned ones, so that the strips the segmentation leaves between faces fill and a
+/// free-form patch does not.
+fn explained_triangles(
+    mesh: &TriMesh,
+    face_surface: &[i32],
+    surfaces: &[SurfaceParams],
+    neighbours: &[Vec<u32>],
+) -> Vec<bool> {
+    let p = &mesh.vertices.positions;
+    let (mut sq, mut count) = (0.0, 0usize);
+    for (f, &l) in mesh.faces.iter().zip(face_surface) {
+        if let Ok(l) = usize::try_from(l) {
+            for &v in f {
+                sq += signed_distance(&surfaces[l], p[v as usize]).powi(2);
+                count += 1;
+            }
+        }
+    }
+    let noise = 3.0 * (sq / count.max(1) as f64).sqrt();
+    let mut label: Vec<i32> = face_surface.to_vec();
+    let mut frontier: Vec<u32> = (0..label.len() as u32)
+        .filter(|&t| label[t as usize] >= 0)
+        .collect();
+    while !frontier.is_empty() {
+        let mut claims: Vec<(u32, i32)> = Vec::new();
+        for &t in &frontier {
+            let l = label[t as usize];
+            for &u in &neighbours[t as usize] {
+                if label[u as usize] >= 0 {
+                    continue;
+                }
+                let corners = mesh.faces[u as usize].map(|v| p[v as usize]);
+                let reach = noise
+                    + (0..3)
+                        .map(|k| dist(corners[k], corners[(k + 1) % 3]))
+                        .fold(0.0, f64::max);
+                let s = &surfaces[l as usize];
+                if corners
+                    .iter()
+                    .all(|&c| signed_distance(s, c).abs() <= reach)
+                {
+                    claims.push((u, l));
+                }
+            }
+        }
+        // The lowest label wins a triangle claimed twice in one round.
+        claims.sort_unstable();
+        frontier.clear();
+        for (u, l) in claims {
+            if label[u as usize] < 0 {
+                label[u as usize] = l;
+                frontier.push(u);
+            }
+        }
+    }
+    label.iter().map(|&l| l >= 0).collect()
+}
+
+/// Why [`build`] gave no B-rep.
+enum Failure {
+    /// The surfaces found do not meet where the mesh's regions do: the smallest region at each
+    /// place where they fail (its surface and triangles), and what failed (the worst place).
+    Mismatch {
+        regions: Vec<(usize, Vec<u32>)>,
+        message: String,
+        /// Per triangle: the surface of its region (unassigned triangles and islands
+        /// resolved), for building again without the regions.
+        labels: Vec<i32>,
+    },
+    /// Anything else.
+    Error(Error),
+}
+
+impl From<Error> for Failure {
+    fn from(e: Error) -> Self {
+        Failure::Error(e)
+    }
+}
+
 /// [`brep_from_mesh`], with the residuals measured on `fit` when given (else on the mesh).
 fn build(
     mesh: &TriMesh,
     face_surface: &[i32],
     surfaces: &[SurfaceParams],
     fit: Option<&Fit>,
-) -> Result<Reconstruction> {
+) -> std::result::Result<Reconstruction, Failure> {
     if let Some(&bad) = face_surface
         .iter()
         .find(|&&s| s >= 0 && s as usize >= surfaces.len())
@@ -340,7 +619,8 @@ fn build(
         return Err(Error::InvalidArgument(format!(
             "reconstruct: face label {bad} but only {} surfaces",
             surfaces.len()
-        )));
+        ))
+        .into());
     }
     let mut topo = topology::topology(mesh, face_surface, surfaces)?;
     let pos = |v: u32| topology::position(mesh, v);
@@ -349,6 +629,16 @@ fn build(
         .filter(|d| *d > 0.0)
         .ok_or_else(|| Error::InvalidInput("reconstruct: the mesh has no extent".into()))?;
     let nr = topo.surface_of_region.len();
+    tracing::debug!(
+        "topology: {nr} regions on surfaces {:?}, {} edges {:?}, {} vertices",
+        topo.surface_of_region,
+        topo.edges.len(),
+        topo.edges
+            .iter()
+            .map(|e| (e.left, e.right, e.start, e.end, e.chain.len()))
+            .collect::<Vec<_>>(),
+        topo.vertices.len()
+    );
     // Relations within the noise made exact (module `snap`).
     let (surfaces, snaps) = snap_surfaces(mesh, &topo, surfaces, size, fit);
     let surfaces = &surfaces[..];
@@ -386,15 +676,48 @@ fn build(
     // A mesh's planar border is planar to a tenth of an edge.
     let border_flatness = fit.map_or(0.1, |f| f.border_flatness);
     let tol = 0.1 * spacing;
+    // (Only when the mesh has the whole edge within `MAX_MOVE` of that point: a long chain
+    // whose ends solve to one point is surfaces meeting elsewhere, which the checks below
+    // catch, not a point contact.)
     let drop: Vec<bool> = topo
         .edges
         .iter()
-        .map(|e| e.start != e.end && dist(vertices[e.start], vertices[e.end]) < tol)
+        .map(|e| {
+            let p = vertices[e.start];
+            e.start != e.end
+                && dist(p, vertices[e.end]) < tol
+                && e.chain
+                    .iter()
+                    .all(|&v| dist(pos(v), p) <= MAX_MOVE * spacing)
+        })
         .collect();
     if drop.contains(&true) {
+        tracing::debug!(
+            "edges collapsed (their ends solved within {tol:.3e}): {:?}",
+            (0..drop.len()).filter(|&e| drop[e]).collect::<Vec<_>>()
+        );
         topo.collapse_edges(&drop);
         (at_vertex, vertices) = solve_vertices(&topo, &edge_surfaces, &pos);
     }
+    // A region left without edges is gone (a ball touching a face in a point leaves a sliver);
+    // one wider than `MAX_MOVE` each way cannot have shrunk to a point: its surface does not
+    // meet its neighbours where the mesh says.
+    let mut extent: Vec<Option<Aabb>> = vec![None; nr];
+    for (t, f) in mesh.faces.iter().enumerate() {
+        let b = &mut extent[topo.region_of_face[t] as usize];
+        for &v in f {
+            match b {
+                Some(b) => b.grow(pos(v)),
+                None => *b = Aabb::from_points(&[pos(v)]),
+            }
+        }
+    }
+    let vanished: Vec<u32> = (0..nr as u32)
+        .filter(|&r| {
+            topo.loops[r as usize].is_empty()
+                && extent[r as usize].is_some_and(|b| b.diagonal() > 2.0 * MAX_MOVE * spacing)
+        })
+        .collect();
     // The largest gap, and where: a point and the surfaces that should meet there.
     let mut max_gap: f64 = 0.0;
     let mut worst = String::new();
@@ -411,15 +734,31 @@ fn build(
             );
         }
     };
+    // Where the surfaces do not meet (a vertex or an edge off its surfaces by more than
+    // `MAX_GAP` edges, a vertex solved more than `MAX_MOVE` edges from its mesh vertex): the
+    // regions there.
+    let limit = MAX_GAP * spacing;
+    let mut failing: Vec<Vec<u32>> = vanished.iter().map(|&r| vec![r]).collect();
+    let mut around: Vec<Vec<u32>> = vec![Vec::new(); vertices.len()];
+    for e in &topo.edges {
+        for v in [e.start, e.end] {
+            for r in [e.left, e.right] {
+                if r != topology::OUTSIDE && !around[v].contains(&r) {
+                    around[v].push(r);
+                }
+            }
+        }
+    }
     for (v, (p, surfs)) in vertices.iter().zip(&at_vertex).enumerate() {
+        let mesh_vertex = pos(topo.vertices[v]);
+        let mut gap: f64 = 0.0;
         for s in surfs {
-            let mesh_vertex = pos(topo.vertices[v]);
-            note(
-                signed_distance(s, *p).abs(),
-                mesh_vertex,
-                surfs,
-                &mut max_gap,
-            );
+            let d = signed_distance(s, *p).abs();
+            note(d, mesh_vertex, surfs, &mut max_gap);
+            gap = gap.max(d);
+        }
+        if gap > limit || dist(*p, mesh_vertex) > MAX_MOVE * spacing {
+            failing.push(around[v].clone());
         }
     }
 
@@ -480,18 +819,41 @@ fn build(
                     let along = intersect::march(&a, &b, p0, p1, &pts, step)
                         .unwrap_or_else(|| thin_chain(&pts, spacing));
                     (spline_on(&surfs, along, spacing), true)
+                } else if fit.is_some()
+                    && !matches!(surfs[..], [SurfaceParams::Plane { .. }])
+                    && pts.len() > 3
+                {
+                    // A cloud's rim across a curved surface: the envelope's ragged chain,
+                    // smoothed on the surface, as a spline on it (a polyline leaves the surface
+                    // between its points, and its zigzags fold the face).
+                    let smooth = smooth_on(&surfs, pts, 3);
+                    (
+                        spline_on(&surfs, thin_chain(&smooth, spacing), spacing),
+                        true,
+                    )
                 } else {
                     (Curve::polyline(pts), true)
                 }
             }
         };
+        let mut gap = curve.distance(p0).max(curve.distance(p1));
         note(curve.distance(p0), p0, &surfs, &mut max_gap);
         note(curve.distance(p1), p1, &surfs, &mut max_gap);
         // A fitted curve leaves its surfaces between its points.
         for q in curve.samples() {
             for sf in &surfs {
-                note(signed_distance(sf, q).abs(), q, &surfs, &mut max_gap);
+                let d = signed_distance(sf, q).abs();
+                note(d, q, &surfs, &mut max_gap);
+                gap = gap.max(d);
             }
+        }
+        if gap > limit {
+            failing.push(
+                [e.left, e.right]
+                    .into_iter()
+                    .filter(|&r| r != topology::OUTSIDE)
+                    .collect(),
+            );
         }
         if e.right == topology::OUTSIDE {
             border_edges += 1;
@@ -509,45 +871,92 @@ fn build(
     }
     // A vertex solved far from where the mesh has it: the surfaces meet, but elsewhere (two
     // nearly coaxial cylinders cross far away).
-    if let Some((v, moved)) = vertices
-        .iter()
-        .enumerate()
-        .map(|(v, p)| (v, dist(*p, pos(topo.vertices[v]))))
-        .find(|&(_, d)| d > MAX_MOVE * spacing)
-    {
-        let at = pos(topo.vertices[v]);
-        let kinds: Vec<&str> = at_vertex[v].iter().map(|s| s.kind().name()).collect();
-        return Err(Error::InvalidInput(format!(
-            "reconstruct: the surfaces found do not meet where the mesh says they do: near \
-             ({:.4}, {:.4}, {:.4}), the {} meet {moved:.3e} away ({:.1} mesh edges, at most \
-             {MAX_MOVE} allowed), so no valid B-rep can be built; the part's surfaces were not \
-             all found (free-form or too noisy?)",
-            at[0],
-            at[1],
-            at[2],
-            kinds.join(", "),
-            moved / spacing
-        )));
-    }
-    if max_gap > MAX_GAP * spacing {
-        return Err(Error::InvalidInput(format!(
-            "reconstruct: the surfaces found do not meet where the mesh says they do: {worst}, \
-             a vertex or an edge lies {max_gap:.3e} from one of them ({:.2} mesh edges, at most \
-             {MAX_GAP} allowed), so no valid B-rep can be built; the part's surfaces were not \
-             all found (free-form or too noisy?)",
-            max_gap / spacing
-        )));
+    let areas = face_areas(mesh);
+    if !failing.is_empty() {
+        let message = match vertices
+            .iter()
+            .enumerate()
+            .map(|(v, p)| (v, dist(*p, pos(topo.vertices[v]))))
+            .find(|&(_, d)| d > MAX_MOVE * spacing)
+        {
+            Some((v, moved)) => {
+                let at = pos(topo.vertices[v]);
+                let kinds: Vec<&str> = at_vertex[v].iter().map(|s| s.kind().name()).collect();
+                format!(
+                    "near ({:.4}, {:.4}, {:.4}), the {} meet {moved:.3e} away ({:.1} mesh edges, \
+                     at most {MAX_MOVE} allowed)",
+                    at[0],
+                    at[1],
+                    at[2],
+                    kinds.join(", "),
+                    moved / spacing
+                )
+            }
+            None if max_gap > limit => format!(
+                "{worst}, a vertex or an edge lies {max_gap:.3e} from one of them ({:.2} mesh \
+                 edges, at most {MAX_GAP} allowed)",
+                max_gap / spacing
+            ),
+            None => {
+                let r = vanished.first().map_or(0, |&r| r as usize);
+                let at = extent[r].map_or([0.0; 3], |b| b.center());
+                format!(
+                    "near ({:.4}, {:.4}, {:.4}), the edges of a {} face all shrink to points",
+                    at[0],
+                    at[1],
+                    at[2],
+                    surfaces[surface_of_region[r]].kind().name()
+                )
+            }
+        };
+        // The smallest region at each place: the surface with the least evidence.
+        let mut region_area = vec![0.0; nr];
+        for (t, &r) in topo.region_of_face.iter().enumerate() {
+            region_area[r as usize] += areas[t];
+        }
+        let mut out = vec![false; nr];
+        for regions in &failing {
+            if let Some(&r) = regions
+                .iter()
+                .min_by(|&&a, &&b| region_area[a as usize].total_cmp(&region_area[b as usize]))
+            {
+                out[r as usize] = true;
+            }
+        }
+        let mut triangles: Vec<Vec<u32>> = vec![Vec::new(); nr];
+        for (t, &r) in topo.region_of_face.iter().enumerate() {
+            if out[r as usize] {
+                triangles[r as usize].push(t as u32);
+            }
+        }
+        let regions = triangles
+            .into_iter()
+            .enumerate()
+            .filter(|(_, t)| !t.is_empty())
+            .map(|(r, t)| (topo.surface_of_region[r], t))
+            .collect();
+        let labels = topo
+            .region_of_face
+            .iter()
+            .map(|&r| topo.surface_of_region[r as usize] as i32)
+            .collect();
+        return Err(Failure::Mismatch {
+            labels,
+            regions,
+            message: format!(
+                "the surfaces found do not meet where the mesh says they do: {message}"
+            ),
+        });
     }
     if border_edges > 0 {
         warnings.push(format!(
-            "the input has an open border ({border_edges} edges with a face on one side only): \
+            "the B-rep has an open border ({border_edges} edges with a face on one side only): \
              written as an open shell, not a solid"
         ));
     }
 
     // Faces: orientation from the mesh, residuals of the mesh vertices.
     let normals = face_normals(mesh);
-    let areas = face_areas(mesh);
     let mut orient = vec![0.0; nr];
     let mut direction = vec![[0.0; 3]; nr];
     for (t, f) in mesh.faces.iter().enumerate() {
@@ -611,7 +1020,8 @@ fn build(
         return Err(Error::InvalidInput(format!(
             "reconstruct: the faces found form {shells} separate shells where the input is one \
              piece (the surfaces found do not meet where the mesh says they do; too noisy?)"
-        )));
+        ))
+        .into());
     }
     let closed = border_edges == 0;
     let mut brep = Brep {
@@ -647,6 +1057,8 @@ fn build(
         seams: topo.cuts.len(),
         snaps,
         warnings,
+        left_out: Vec::new(),
+        unexplained: 0.0,
     };
     Ok(Reconstruction { brep, report })
 }
@@ -801,7 +1213,6 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
     // A sheet (an open surface, a single-view scan): the envelope's front only.
     let normals = analysis.normals()?;
     let front = envelope::front_side(&env.mesh, points, normals, &index);
-    let sheet = front.is_some();
     let (mesh, face_labels) = match front {
         Some(keep) => {
             let faces: Vec<[u32; 3]> = env
@@ -836,26 +1247,7 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
         rms,
         border_flatness: 1.0,
     };
-    let mut rec = build(&mesh, &face_labels, &surfaces, Some(&fit))?;
-    // The border of a sheet follows the envelope's ragged rim: exact on a plane, but a
-    // polyline across a curved surface leaves it between its points.
-    if sheet {
-        let curved_rim = rec.brep.edges.iter().any(|e| {
-            matches!(e.curve, Curve::BSpline { degree: 1, .. })
-                && e.faces
-                    .iter()
-                    .flatten()
-                    .any(|&f| !matches!(rec.brep.faces[f].surface, SurfaceParams::Plane { .. }))
-        });
-        if curved_rim {
-            return Err(Error::InvalidInput(
-                "reconstruct: the cloud is an open sheet (a single-view scan or an open surface) \
-                 whose border crosses a curved surface; open shells from clouds are built only \
-                 where the border runs over planes in this version"
-                    .into(),
-            ));
-        }
-    }
+    let mut rec = build_open(&mesh, &face_labels, &surfaces, Some(&fit))?;
     rec.report.snaps.splice(0..0, merges);
     rec.report.noise_ratio = analysis.noise_ratio()?;
     rec.report.segmentation = "points";
@@ -1222,6 +1614,24 @@ fn border_line(
 /// before (the border between two regions of a noisy mesh zigzags about the curve, and its
 /// points projected onto it can step backwards, which an interpolating spline turns into
 /// loops). The ends are kept.
+/// The chain `pts` (ends fixed) smoothed by `rounds` of averaging each inner point with its
+/// two neighbours on each side, put back on the surfaces after each round.
+fn smooth_on(surfs: &[SurfaceParams], mut pts: Vec<Point3>, rounds: usize) -> Vec<Point3> {
+    let n = pts.len();
+    for _ in 0..rounds {
+        let old = pts.clone();
+        for (i, p) in pts.iter_mut().enumerate().take(n - 1).skip(1) {
+            let (lo, hi) = (i.saturating_sub(2), (i + 2).min(n - 1));
+            let mut c = [0.0; 3];
+            for q in &old[lo..=hi] {
+                c = crate::geometry::vec3::add(c, *q);
+            }
+            *p = intersect::on_surfaces(surfs, scale(c, 1.0 / (hi - lo + 1) as f64));
+        }
+    }
+    pts
+}
+
 fn thin_chain(pts: &[Point3], spacing: f64) -> Vec<Point3> {
     let n = pts.len();
     if n <= 2 {

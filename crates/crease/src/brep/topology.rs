@@ -76,6 +76,12 @@ impl HalfEdges<'_> {
     }
 }
 
+/// Whether the mesh is one the topology can read (an oriented 2-manifold without repeated
+/// vertices in a triangle); the error says why not.
+pub(crate) fn check(mesh: &TriMesh) -> Result<()> {
+    half_edges(mesh).map(|_| ())
+}
+
 fn half_edges(mesh: &TriMesh) -> Result<HalfEdges<'_>> {
     let faces = &mesh.faces[..];
     let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(faces.len() * 3);
