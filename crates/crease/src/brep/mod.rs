@@ -80,6 +80,13 @@ pub const MAX_GAP: f64 = 0.1;
 /// meet elsewhere, not where the mesh's regions do, and the B-rep is refused.
 pub const MAX_MOVE: f64 = 10.0;
 
+/// The sharpest turn, in degrees, a fitted edge's control polygon may take between two legs:
+/// away from its ends, an intersection curve sampled finely enough turns by a few degrees per
+/// leg (at most 9 on the parts measured); a turn of tens of degrees is a corner of the
+/// intersection (the surfaces nearly tangent there: two cylinders of nearly equal radii
+/// crossing), and the B-rep is not built with that edge.
+pub const MAX_TURN: f64 = 45.0;
+
 /// The 3D curve of an edge.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
@@ -161,6 +168,26 @@ impl Curve {
             }
             _ => Vec::new(),
         }
+    }
+
+    /// The largest angle, in degrees, between consecutive legs of a B-spline's control polygon
+    /// away from its ends (where an interpolating spline may hook; 0 for a line or a circle).
+    pub fn max_turn(&self) -> f64 {
+        let Curve::BSpline { control_points, .. } = self else {
+            return 0.0;
+        };
+        let n = control_points.len();
+        if n < 5 {
+            return 0.0;
+        }
+        control_points[1..n - 1]
+            .windows(3)
+            .filter_map(|w| {
+                let a = normalize(sub(w[1], w[0]))?;
+                let b = normalize(sub(w[2], w[1]))?;
+                Some(dot(a, b).clamp(-1.0, 1.0).acos().to_degrees())
+            })
+            .fold(0.0, f64::max)
     }
 
     /// Distance from `p` to the curve (for a B-spline, to the polygon of its
@@ -479,6 +506,7 @@ fn build_open(
                 message,
                 labels,
             }) => {
+                tracing::debug!("leaving out {} region(s): {message}", regions.len());
                 let first = first.get_or_insert(message);
                 for (&t, l) in kept.iter().zip(labels) {
                     labels_now[t as usize] = l;
@@ -739,6 +767,7 @@ fn build(
     // regions there.
     let limit = MAX_GAP * spacing;
     let mut failing: Vec<Vec<u32>> = vanished.iter().map(|&r| vec![r]).collect();
+    let mut corner: Option<String> = None;
     let mut around: Vec<Vec<u32>> = vec![Vec::new(); vertices.len()];
     for e in &topo.edges {
         for v in [e.start, e.end] {
@@ -847,7 +876,35 @@ fn build(
                 gap = gap.max(d);
             }
         }
-        if gap > limit {
+        // A spline that turns sharply between two control points follows a corner of the
+        // intersection (surfaces nearly tangent there, as two equal cylinders crossing),
+        // which it cannot represent, nor a kernel project onto the surfaces.
+        // (A border's polyline may turn: only an intersection is checked.)
+        let turn = if surfs.len() == 2 {
+            curve.max_turn()
+        } else {
+            0.0
+        };
+        if turn > MAX_TURN && corner.is_none() {
+            let kinds: Vec<&str> = surfs.iter().map(|s| s.kind().name()).collect();
+            corner = Some(format!(
+                "near ({:.4}, {:.4}, {:.4}), the {} meet in a curve with a corner (a turn of \
+                 {turn:.0} degrees between two control points of its spline, at most {MAX_TURN}; \
+                 the surfaces are nearly tangent there)",
+                p0[0],
+                p0[1],
+                p0[2],
+                kinds.join(", ")
+            ));
+        }
+        if gap > limit || turn > MAX_TURN {
+            tracing::debug!(
+                "edge {}-{} between regions {} and {} fails: gap {gap:.3e}, turn {turn:.1}",
+                e.start,
+                e.end,
+                e.left,
+                e.right
+            );
             failing.push(
                 [e.left, e.right]
                     .into_iter()
@@ -897,17 +954,19 @@ fn build(
                  edges, at most {MAX_GAP} allowed)",
                 max_gap / spacing
             ),
-            None => {
-                let r = vanished.first().map_or(0, |&r| r as usize);
-                let at = extent[r].map_or([0.0; 3], |b| b.center());
-                format!(
-                    "near ({:.4}, {:.4}, {:.4}), the edges of a {} face all shrink to points",
-                    at[0],
-                    at[1],
-                    at[2],
-                    surfaces[surface_of_region[r]].kind().name()
-                )
-            }
+            None => match vanished.first() {
+                Some(&r) => {
+                    let at = extent[r as usize].map_or([0.0; 3], |b| b.center());
+                    format!(
+                        "near ({:.4}, {:.4}, {:.4}), the edges of a {} face all shrink to points",
+                        at[0],
+                        at[1],
+                        at[2],
+                        surfaces[surface_of_region[r as usize]].kind().name()
+                    )
+                }
+                None => corner.unwrap_or_default(),
+            },
         };
         // The smallest region at each place: the surface with the least evidence.
         let mut region_area = vec![0.0; nr];
