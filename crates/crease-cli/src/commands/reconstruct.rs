@@ -1,7 +1,7 @@
-//! `crease reconstruct IN -o part.step [--topology topo.json] [--units mm]`: the part as a
-//! boundary representation (B-rep) in a STEP file (`crease::brep`): the mesh segmented into
-//! analytic surfaces, their intersection curves and vertices, a solid when the mesh is closed
-//! and an open shell otherwise. A point cloud goes through the shared analysis and its
+//! `crease reconstruct IN -o part.step [--mesh part.ply] [--topology topo.json] [--units mm]`:
+//! the part as a boundary representation (B-rep) in a STEP file (`crease::brep`): the mesh
+//! segmented into analytic surfaces, their intersection curves and vertices, a solid when the
+//! mesh is closed and an open shell otherwise; optionally also tessellated. A point cloud goes through the shared analysis and its
 //! envelope (`crease::brep::reconstruct_cloud`).
 
 use std::path::PathBuf;
@@ -26,6 +26,11 @@ pub struct ReconstructArgs {
     /// Output STEP file (.step or .stp).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Also write the B-rep as a triangle mesh (any mesh format crease writes: .ply .obj .off
+    /// .stl): each face's triangles on its surface, sharing the vertices of its edges, with the
+    /// B-rep face and surface type of every triangle (`face`, `surface_type`).
+    #[arg(long, value_name = "MESH")]
+    pub mesh: Option<PathBuf>,
     /// Also write the B-rep's topology and geometry as JSON: faces with their surface type and
     /// parameters and loops, edges with their curve and two faces, vertices.
     #[arg(long, value_name = "JSON")]
@@ -65,6 +70,7 @@ pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
     }
     let mut outputs = vec![&a.output];
     outputs.extend(a.topology.iter());
+    outputs.extend(a.mesh.iter());
     for o in &outputs {
         crate::ui::ensure_not_input(o, &[&a.input])?;
     }
@@ -120,6 +126,11 @@ pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
         .with_context(|| format!("cannot write {}", a.output.display()))?;
     if let Some(p) = &a.topology {
         crate::ui::write_text(p, &(serde_json::to_string_pretty(&rec.brep)? + "\n"))
+            .with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    if let Some(p) = &a.mesh {
+        let out = crease::io::Geometry::from_mesh(rec.tessellate()?);
+        super::save(g, p, &out, false, &[&a.input])
             .with_context(|| format!("cannot write {}", p.display()))?;
     }
     for w in &rec.report.warnings {

@@ -622,3 +622,76 @@ fn open_clouds_become_open_shells_bounded_where_the_samples_end() {
         }
     }
 }
+
+#[test]
+fn the_b_rep_is_also_written_tessellated_on_its_surfaces() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // A cloud (its envelope's triangles put on the surfaces, drawn in from the edges) and a
+    // mesh (its own triangles).
+    let cloud = synth(
+        dir.path(),
+        &["synth", "box-hole", "-n", "50000"],
+        "cloud.xyz",
+    );
+    let mesh = synth(
+        dir.path(),
+        &["synth", "two-cylinders", "--mesh", "-n", "20000"],
+        "mesh.ply",
+    );
+    for (input, faces) in [(&cloud, 7), (&mesh, 0)] {
+        let step = dir.path().join("part.step");
+        let tess = dir.path().join("part.ply");
+        crease()
+            .arg("reconstruct")
+            .arg(input)
+            .arg("-o")
+            .arg(&step)
+            .arg("--mesh")
+            .arg(&tess)
+            .arg("-q")
+            .assert()
+            .success();
+        let (geom, _) = crease::io::read(&tess, &Default::default()).expect("reads");
+        let face = geom.face_attributes.get("face").expect("face attribute");
+        let mut ids: Vec<i64> = face.values.iter().map(|&f| f as i64).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        let occ = check(&step, None);
+        let brep_faces: u64 = faces_of(&occ);
+        if faces > 0 {
+            assert_eq!(brep_faces, faces, "{occ}");
+        }
+        // Every B-rep face has triangles, and they cover its area.
+        assert_eq!(
+            ids,
+            (0..brep_faces as i64).collect::<Vec<_>>(),
+            "{}",
+            input.display()
+        );
+        let area = mesh_area(&tess);
+        let want = occ["area"].as_f64().expect("area");
+        assert!(
+            (area - want).abs() < 0.01 * want,
+            "{}: tessellated area {area} against the B-rep's {want}",
+            input.display()
+        );
+        // Its vertices lie on the B-rep.
+        let xyz = dir.path().join("tess.xyz");
+        crease()
+            .arg("convert")
+            .arg(&tess)
+            .arg(&xyz)
+            .arg("-q")
+            .assert()
+            .success();
+        let occ = check(&step, Some((&xyz, 10)));
+        let far = occ["max_distance"].as_f64().unwrap_or(f64::INFINITY);
+        let mean = occ["mean_distance"].as_f64().unwrap_or(f64::INFINITY);
+        assert!(far < 5e-3 && mean < 1e-5, "{}: {occ}", input.display());
+    }
+}
+
+/// The number of faces OpenCASCADE found.
+fn faces_of(occ: &serde_json::Value) -> u64 {
+    faces(occ).iter().map(|(_, n)| n).sum()
+}

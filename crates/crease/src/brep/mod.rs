@@ -323,6 +323,28 @@ pub struct Reconstruction {
     pub brep: Brep,
     /// Counts and residuals.
     pub report: BrepReport,
+    /// What [`Reconstruction::tessellate`] needs of the mesh the B-rep was read from.
+    #[serde(skip)]
+    source: TessellationSource,
+}
+
+/// What the tessellation of a B-rep needs of the mesh (or envelope) it was read from, kept so
+/// that it is made only when asked for.
+#[derive(Debug, Clone, PartialEq)]
+struct TessellationSource {
+    mesh: TriMesh,
+    /// Per triangle: its region.
+    region_of_face: Vec<u32>,
+    /// Per region: its surface and its B-rep face (none: dropped).
+    regions: Vec<(SurfaceParams, Option<usize>)>,
+    /// Per edge: its chain of mesh vertices and the surfaces it lies on.
+    chains: Vec<(Vec<u32>, Vec<SurfaceParams>)>,
+    /// Per B-rep vertex: its mesh vertex.
+    vertex_mesh: Vec<u32>,
+    /// Triangles to turn over (a mesh walked clockwise).
+    reversed: bool,
+    /// Relax the vertices near the edges (a cloud's envelope).
+    relax: bool,
 }
 
 impl Reconstruction {
@@ -336,6 +358,16 @@ impl Reconstruction {
     /// The uncertainty [`Reconstruction::to_step`] writes.
     pub fn uncertainty(&self, size: f64) -> f64 {
         (2.0 * self.report.max_gap).max(1e-9 * size)
+    }
+
+    /// The B-rep as triangles: the mesh's (or a cloud's envelope's) triangles of each face,
+    /// with every vertex put on the B-rep (a vertex's mesh vertex on the solved vertex, an
+    /// edge's chain on the surfaces of its faces, the rest on its face's surface; for a cloud,
+    /// also drawn in from the edges, which its envelope rounds off), so that faces sharing an
+    /// edge share its vertices; per triangle its face (`face`) and surface type
+    /// (`surface_type`) as attributes.
+    pub fn tessellate(&self) -> Result<TriMesh> {
+        tessellate(&self.source, &self.brep)
     }
 }
 
@@ -408,13 +440,15 @@ fn build_open(
     let mut keep = vec![true; nt];
     let mut left_out: Vec<LeftOut> = Vec::new();
     let mut first: Option<String> = None;
-    let neighbours = pieces::edge_neighbours(mesh);
+    // Triangles across each edge: only needed when something is left out.
+    let neighbours = std::cell::OnceCell::new();
+    let neighbours = || neighbours.get_or_init(|| pieces::edge_neighbours(mesh));
     let mut labels_now = face_surface.to_vec();
     // Unassigned triangles that no surface explains (a free-form patch, a missed surface) are
     // left out; the rest fill the strips between regions.
     let mut unexplained = 0.0;
-    if fit.is_none() {
-        let explained = explained_triangles(mesh, face_surface, surfaces, &neighbours);
+    if fit.is_none() && face_surface.iter().any(|&l| l < 0) {
+        let explained = explained_triangles(mesh, face_surface, surfaces, neighbours());
         for (t, e) in explained.iter().enumerate() {
             if !e {
                 keep[t] = false;
@@ -422,7 +456,7 @@ fn build_open(
             }
         }
         if unexplained > 0.0 {
-            let remaining = pieces::manifold_piece(mesh, &keep, &neighbours);
+            let remaining = pieces::manifold_piece(mesh, &keep, neighbours());
             let share = remaining.as_deref().map_or(0.0, share_of);
             if share < MIN_EXPLAINED {
                 // (A mesh the topology cannot read says so first.)
@@ -529,7 +563,7 @@ fn build_open(
                         near: scale(centroid, 1.0 / area.max(f64::MIN_POSITIVE)),
                     });
                 }
-                let remaining = pieces::manifold_piece(mesh, &keep, &neighbours);
+                let remaining = pieces::manifold_piece(mesh, &keep, neighbours());
                 let explained: f64 = remaining.as_deref().map_or(0.0, share_of);
                 if explained < MIN_EXPLAINED {
                     return Err(refusal(
@@ -1073,6 +1107,14 @@ fn build(
         })
         .collect();
     // A face whose every edge was collapsed (a ball touching a face in a point) is gone.
+    let mut face_of_region = vec![None; nr];
+    for (r, id) in (0..nr)
+        .filter(|&r| !topo.loops[r].is_empty())
+        .enumerate()
+        .map(|(id, r)| (r, id))
+    {
+        face_of_region[r] = Some(id);
+    }
     let (faces, edges) = drop_empty_faces(faces, edges);
     let shells = shells(faces.len(), &edges);
     if shells > 1 {
@@ -1090,9 +1132,25 @@ fn build(
         closed,
     };
     // A closed mesh walked clockwise from outside (negative volume) gives a part inside out.
-    if closed && signed_volume(mesh) < 0.0 {
+    let reversed = closed && signed_volume(mesh) < 0.0;
+    if reversed {
         brep.reverse();
     }
+    let source = TessellationSource {
+        mesh: mesh.clone(),
+        region_of_face: topo.region_of_face.clone(),
+        regions: (0..nr)
+            .map(|r| (surfaces[topo.surface_of_region[r]], face_of_region[r]))
+            .collect(),
+        chains: topo
+            .edges
+            .iter()
+            .map(|e| (e.chain.clone(), edge_surfaces(e.left, e.right)))
+            .collect(),
+        vertex_mesh: topo.vertices.clone(),
+        reversed,
+        relax: fit.is_some(),
+    };
     let mut faces_by_type = BTreeMap::new();
     for f in &brep.faces {
         *faces_by_type.entry(f.surface.kind().name()).or_insert(0) += 1;
@@ -1119,7 +1177,160 @@ fn build(
         left_out: Vec::new(),
         unexplained: 0.0,
     };
-    Ok(Reconstruction { brep, report })
+    Ok(Reconstruction {
+        brep,
+        report,
+        source,
+    })
+}
+
+/// `p` put on all of `surfs` (a single surface: along its normal; none: `p`).
+fn onto(surfs: &[SurfaceParams], p: Point3) -> Point3 {
+    match surfs {
+        [] => p,
+        [s] => {
+            let q = sub(p, scale(surface_normal(s, p), signed_distance(s, p)));
+            // (A cone's or torus's normal step lands near it: finish on the surface.)
+            if signed_distance(s, q).abs() > 1e-12 * (1.0 + norm(p)) {
+                intersect::on_surfaces(surfs, q)
+            } else {
+                q
+            }
+        }
+        _ => intersect::on_surfaces(surfs, p),
+    }
+}
+
+/// Rounds of relaxation of a cloud's tessellation (see `tessellate`): the envelope's rounded
+/// edges are a few grid cells wide.
+const RELAX_ROUNDS: usize = 30;
+
+/// How many rings of vertices around a cloud's edges relax (see `tessellate`): the envelope's
+/// rounded edges are a few grid cells wide.
+const RELAX_RINGS: usize = 8;
+
+/// [`Reconstruction::tessellate`].
+fn tessellate(source: &TessellationSource, brep: &Brep) -> Result<TriMesh> {
+    use rayon::prelude::*;
+    let mesh = &source.mesh;
+    let positions = &mesh.vertices.positions;
+    // Per mesh vertex: the surfaces it lies on (none yet: unused).
+    let mut on: Vec<Vec<SurfaceParams>> = vec![Vec::new(); positions.len()];
+    for (t, f) in mesh.faces.iter().enumerate() {
+        let r = source.region_of_face[t] as usize;
+        for &v in f {
+            if on[v as usize].is_empty() {
+                on[v as usize] = vec![source.regions[r].0];
+            }
+        }
+    }
+    for (chain, surfs) in &source.chains {
+        for &v in chain {
+            on[v as usize].clone_from(surfs);
+        }
+    }
+    let mut placed: Vec<Point3> = positions
+        .par_iter()
+        .zip(&on)
+        .map(|(&p, surfs)| onto(surfs, p))
+        .collect();
+    for (&mv, &p) in source.vertex_mesh.iter().zip(&brep.vertices) {
+        placed[mv as usize] = p;
+    }
+    if source.relax {
+        // A face's vertices near its edges, put on its surface, overshoot the edge (the
+        // envelope rounds the part's edges off): each is moved to the mean of its neighbours on
+        // the surface, edges and vertices fixed, until the flaps are drawn in.
+        // (An edge's chain relaxes along the chain, on its curve, between its fixed ends.) Only
+        // the vertices within `RELAX_RINGS` rings of an edge move: farther in, a face's vertices
+        // already lie inside it.
+        let mut around: Vec<Vec<u32>> = vec![Vec::new(); positions.len()];
+        for f in &mesh.faces {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                around[a as usize].push(b);
+                around[b as usize].push(a);
+            }
+        }
+        let mut ring = vec![usize::MAX; positions.len()];
+        let mut band: Vec<u32> = Vec::new();
+        for (chain, _) in &source.chains {
+            for &v in chain {
+                if ring[v as usize] == usize::MAX {
+                    ring[v as usize] = 0;
+                    band.push(v);
+                }
+            }
+        }
+        let mut frontier = band.clone();
+        for r in 1..=RELAX_RINGS {
+            let mut next = Vec::new();
+            for &v in &frontier {
+                for &u in &around[v as usize] {
+                    if ring[u as usize] == usize::MAX {
+                        ring[u as usize] = r;
+                        next.push(u);
+                    }
+                }
+            }
+            band.extend_from_slice(&next);
+            frontier = next;
+        }
+        for (chain, _) in &source.chains {
+            for w in chain.windows(3) {
+                around[w[1] as usize] = vec![w[0], w[2]];
+            }
+        }
+        for &v in &source.vertex_mesh {
+            around[v as usize].clear();
+        }
+        band.sort_unstable();
+        for _ in 0..RELAX_ROUNDS {
+            let moved: Vec<Point3> = band
+                .par_iter()
+                .map(|&v| {
+                    let v = v as usize;
+                    if around[v].is_empty() || on[v].is_empty() {
+                        return placed[v];
+                    }
+                    let mut c = [0.0; 3];
+                    for &u in &around[v] {
+                        c = crate::geometry::vec3::add(c, placed[u as usize]);
+                    }
+                    onto(&on[v], scale(c, 1.0 / around[v].len() as f64))
+                })
+                .collect();
+            for (&v, p) in band.iter().zip(moved) {
+                placed[v as usize] = p;
+            }
+        }
+    }
+    let mut faces = Vec::with_capacity(mesh.faces.len());
+    let mut face_id = Vec::with_capacity(mesh.faces.len());
+    for (t, f) in mesh.faces.iter().enumerate() {
+        if let Some(id) = source.regions[source.region_of_face[t] as usize].1 {
+            faces.push(if source.reversed {
+                [f[0], f[2], f[1]]
+            } else {
+                *f
+            });
+            face_id.push(id);
+        }
+    }
+    let mut out = compact(&placed, faces)?;
+    out.set_face_attribute(crate::geometry::Attribute::int(
+        "face",
+        face_id.iter().map(|&f| f as i64),
+    ))?;
+    out.set_face_attribute(crate::geometry::Attribute {
+        name: "surface_type".into(),
+        kind: crate::geometry::ScalarKind::U8,
+        values: face_id
+            .iter()
+            .map(|&f| f64::from(brep.faces[f].surface.kind().code()))
+            .collect(),
+    })?;
+    Ok(out)
 }
 
 /// The B-rep of a triangle mesh: its segmentation into analytic surfaces, then
