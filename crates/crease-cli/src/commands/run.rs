@@ -11,7 +11,7 @@
 //! | `labels.ply` | the points with `sharp`, `sharpness`, `surface`, `surface_type`, `fillet_label`, `smooth_edge` (input order) | the mesh with per-face `surface`, `surface_type` and an `edge` element with `sharp`, `sharpness` |
 //! | `network.obj` | sharp and fillet polylines (OBJ groups `sharp`, `smooth`) | the feature-edge polylines (group `sharp`) |
 //! | `surfaces.json` | the surfaces with their parameters | the same |
-//! | `part.step` | the B-rep (`crease::brep::reconstruct_cloud` on the same analysis), when the surfaces close; otherwise the summary says why | not yet (`crease reconstruct`) |
+//! | `part.step` | the B-rep (`crease::brep::reconstruct_cloud` on the same analysis): a solid, or an open shell saying what it leaves out; when none can be built the summary says why | the same (`crease::brep::reconstruct_segmented_mesh` on the same segmentation) |
 //! | `summary.json` | counts, per-stage times, how often each shared piece was computed | the same |
 //! | `picture.png` | the points coloured by surface, the network on top | the mesh coloured by surface, the edges on top |
 
@@ -21,7 +21,7 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use crease::analysis::{AnalysisParams, CloudAnalysis};
-use crease::brep::{reconstruct_cloud, LengthUnit};
+use crease::brep::{reconstruct_cloud, reconstruct_segmented_mesh, LengthUnit};
 use crease::fillets::{curve_network, extract_fillets_from, FilletParams, Label};
 use crease::geometry::{names, Attribute, PointCloud, ScalarKind, TriMesh};
 use crease::io::Geometry;
@@ -165,33 +165,7 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     // The B-rep from the same analysis; a part it cannot close is reported, not fatal (the
     // other outputs stand).
     let s = Stage::start("B-rep (STEP)", g.quiet);
-    let brep = match reconstruct_cloud(&analysis) {
-        Ok(rec) => {
-            let size = crease::Aabb::from_points(points)
-                .map(|b| b.diagonal())
-                .unwrap_or(1.0);
-            let stem = a
-                .input
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "part".into());
-            crate::ui::write_text(
-                &a.output.join("part.step"),
-                &rec.to_step(&stem, LengthUnit::Millimetre, size),
-            )
-            .with_context(|| format!("cannot write {}", a.output.join("part.step").display()))?;
-            serde_json::json!({
-                "solid": rec.report.closed,
-                "faces": rec.brep.faces.len(),
-                "edges": rec.brep.edges.len(),
-                "report": rec.report,
-            })
-        }
-        Err(e) => {
-            tracing::warn!("{name}: no B-rep: {e}");
-            serde_json::json!({ "error": e.to_string() })
-        }
-    };
+    let brep = write_brep(a, &name, points, reconstruct_cloud(&analysis))?;
     timed("brep", s);
 
     let sharp_lines = network.smooth.iter().filter(|&&s| !s).count();
@@ -231,7 +205,46 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     }))
 }
 
-/// The mesh path: feature edges, their polylines, the segmentation of the faces.
+/// Writes `part.step` from the B-rep of the part whose points are `points`, and returns its
+/// summary; a part that cannot be built is reported in the summary, not fatal (the other
+/// outputs stand).
+fn write_brep(
+    a: &RunArgs,
+    name: &str,
+    points: &[crease::geometry::Point3],
+    rec: crease::Result<crease::brep::Reconstruction>,
+) -> anyhow::Result<serde_json::Value> {
+    Ok(match rec {
+        Ok(rec) => {
+            let size = crease::Aabb::from_points(points)
+                .map(|b| b.diagonal())
+                .unwrap_or(1.0);
+            let stem = a
+                .input
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "part".into());
+            let path = a.output.join("part.step");
+            crate::ui::write_text(&path, &rec.to_step(&stem, LengthUnit::Millimetre, size))
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            for w in &rec.report.warnings {
+                tracing::warn!("{name}: B-rep: {w}");
+            }
+            serde_json::json!({
+                "solid": rec.report.closed,
+                "faces": rec.brep.faces.len(),
+                "edges": rec.brep.edges.len(),
+                "report": rec.report,
+            })
+        }
+        Err(e) => {
+            tracing::warn!("{name}: no B-rep: {e}");
+            serde_json::json!({ "error": e.to_string() })
+        }
+    })
+}
+
+/// The mesh path: feature edges, their polylines, the segmentation of the faces, the B-rep.
 fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_json::Value> {
     let name = a.input.display().to_string();
     let mut mesh = geom
@@ -249,6 +262,10 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
         segment_mesh(&mesh, &em.topo, &SegmentParams::default()).with_context(|| name.clone())?;
     drop(em);
     timings.insert("segmentation".into(), serde_json::json!(s.finish()));
+    let s = Stage::start("B-rep (STEP)", g.quiet);
+    let rec = reconstruct_segmented_mesh(&mesh, seg.clone(), &SegmentParams::default());
+    let brep = write_brep(a, &name, &mesh.vertices.positions, rec)?;
+    timings.insert("brep".into(), serde_json::json!(s.finish()));
 
     mesh.set_face_attribute(Attribute::int(
         names::SURFACE,
@@ -291,6 +308,7 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
         "sharp_polylines": lines.len(),
         "surfaces": seg.surfaces.len(),
         "assigned_faces": assigned,
+        "brep": brep,
         "timings": timings,
         "line": format!(
             "{n_sharp} of {n_edges} edges sharp in {} polylines, {} surfaces ({} of {} faces)",

@@ -1346,9 +1346,20 @@ fn tessellate(source: &TessellationSource, brep: &Brep) -> Result<TriMesh> {
 ///
 /// Errors: those of the segmentation and of [`brep_from_mesh`].
 pub fn reconstruct_mesh(mesh: &TriMesh, params: &SegmentParams) -> Result<Reconstruction> {
-    let positions = &mesh.vertices.positions;
     let topo = MeshTopology::new(mesh)?;
     let seg = segment_mesh(mesh, &topo, params)?;
+    drop(topo);
+    reconstruct_segmented_mesh(mesh, seg, params)
+}
+
+/// [`reconstruct_mesh`] from the mesh path's segmentation `seg` of `mesh` (made with
+/// `params`), when the caller has it already (`crease run`).
+pub fn reconstruct_segmented_mesh(
+    mesh: &TriMesh,
+    seg: crate::segment::Segmentation,
+    params: &SegmentParams,
+) -> Result<Reconstruction> {
+    let positions = &mesh.vertices.positions;
     let assigned = seg.face_surface.iter().filter(|&&s| s >= 0).count();
     let noise = if positions.len() > neighbours_needed(&PointParams::default(), false) {
         noise_ratio(positions, &knn(positions, NOISE_K)?)
