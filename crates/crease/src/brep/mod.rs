@@ -900,13 +900,15 @@ fn build(
             }
         };
         let mut gap = curve.distance(p0).max(curve.distance(p1));
-        note(curve.distance(p0), p0, &surfs, &mut max_gap);
-        note(curve.distance(p1), p1, &surfs, &mut max_gap);
+        // (Reported where the mesh has the edge: the curve may stray far from it.)
+        let at = pos(e.chain[e.chain.len() / 2]);
+        note(curve.distance(p0), at, &surfs, &mut max_gap);
+        note(curve.distance(p1), at, &surfs, &mut max_gap);
         // A fitted curve leaves its surfaces between its points.
         for q in curve.samples() {
             for sf in &surfs {
                 let d = signed_distance(sf, q).abs();
-                note(d, q, &surfs, &mut max_gap);
+                note(d, at, &surfs, &mut max_gap);
                 gap = gap.max(d);
             }
         }
