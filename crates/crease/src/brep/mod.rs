@@ -20,8 +20,9 @@
 //! 5. faces: the analytic surface, oriented like the mesh (outward on a closed part), bounded
 //!    by the loops of oriented edges, its seam placed off its boundary;
 //! 6. checks: a vertex or an edge farther than [`MAX_GAP`] mesh edges from one of its
-//!    surfaces, a vertex solved more than [`MAX_MOVE`] mesh edges from its mesh vertex, or a
-//!    face wider than that whose edges all shrink to points: the surfaces found do not meet
+//!    surfaces, a vertex solved more than [`MAX_MOVE`] mesh edges from its mesh vertex, a
+//!    face wider than that whose edges all shrink to points, or a fitted edge turning by more
+//!    than [`MAX_TURN`] (a corner of the intersection): the surfaces found do not meet
 //!    where the regions do (a free-form patch fitted by a cylinder, a surface missed). The
 //!    smallest region at each such place is left out and the rest built again, until it
 //!    builds: an open shell, bounded by the mesh's border where those regions were, each one
@@ -38,8 +39,8 @@
 //! of its envelope.
 //!
 //! Not yet done (issue "scan to CAD"): a cloud's border where the samples end rather than at
-//! its envelope's rim; faces whose surfaces meet only tangentially or in singular curves (two
-//! equal cylinders crossing: a cross bore) are not always valid; ellipses for oblique
+//! its envelope's rim; surfaces meeting in singular curves (two equal cylinders crossing: a
+//! cross bore) built exactly (they are left out today); ellipses for oblique
 //! plane–cylinder edges; a whole sphere or torus as one face with a seam edge (two faces
 //! today). The border of an open shell is the surface's curve in the border's plane when the
 //! border is planar (a tube's circular ends), a line where it is straight on a plane, the
