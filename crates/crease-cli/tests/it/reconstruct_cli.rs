@@ -66,6 +66,17 @@ fn reconstruct(input: &Path, step: &Path) -> serde_json::Value {
     json_of(&out.stdout)
 }
 
+/// `crease convert FROM TO` (the vertices of a mesh as a cloud, for the checker's distances).
+fn convert(from: &Path, to: &Path) {
+    crease()
+        .arg("convert")
+        .arg(from)
+        .arg(to)
+        .arg("-q")
+        .assert()
+        .success();
+}
+
 /// The triangles of a mesh file, as corner positions.
 fn mesh_triangles(path: &Path) -> Vec<[[f64; 3]; 3]> {
     let (geom, _) = crease::io::read(path, &Default::default()).expect("mesh reads");
@@ -166,13 +177,7 @@ fn synthetic_parts_become_valid_solids_with_their_faces_and_exact_volumes() {
         let summary = reconstruct(&mesh, &step);
         assert_eq!(summary["solid"], true, "{shape}: {summary}");
         let xyz = dir.path().join(format!("{shape}.xyz"));
-        crease()
-            .arg("convert")
-            .arg(&mesh)
-            .arg(&xyz)
-            .arg("-q")
-            .assert()
-            .success();
+        convert(&mesh, &xyz);
         let occ = check(&step, Some((&xyz, 40)));
         assert_eq!(occ["valid"], true, "{shape}: {occ}");
         assert_eq!(occ["solids"], 1, "{shape}: {occ}");
@@ -274,13 +279,7 @@ fn classic_meshes_that_close_become_valid_solids() {
         let step = dir.path().join(format!("{name}.step"));
         reconstruct(&mesh, &step);
         let xyz = dir.path().join(format!("{name}.xyz"));
-        crease()
-            .arg("convert")
-            .arg(&mesh)
-            .arg(&xyz)
-            .arg("-q")
-            .assert()
-            .success();
+        convert(&mesh, &xyz);
         let occ = check(&step, Some((&xyz, 7)));
         assert_eq!(occ["valid"], true, "{name}: {occ}");
         assert_eq!(occ["solids"], 1, "{name}: {occ}");
@@ -677,13 +676,7 @@ fn the_b_rep_is_also_written_tessellated_on_its_surfaces() {
         );
         // Its vertices lie on the B-rep.
         let xyz = dir.path().join("tess.xyz");
-        crease()
-            .arg("convert")
-            .arg(&tess)
-            .arg(&xyz)
-            .arg("-q")
-            .assert()
-            .success();
+        convert(&tess, &xyz);
         let occ = check(&step, Some((&xyz, 10)));
         let far = occ["max_distance"].as_f64().unwrap_or(f64::INFINITY);
         let mean = occ["mean_distance"].as_f64().unwrap_or(f64::INFINITY);

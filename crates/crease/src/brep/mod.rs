@@ -478,14 +478,15 @@ fn build_open(
     loop {
         let kept: Vec<u32> = (0..nt as u32).filter(|&t| keep[t as usize]).collect();
         let sub;
-        let (part, labels): (&TriMesh, Vec<i32>) = if kept.len() == nt {
-            (mesh, labels_now.clone())
+        let (part, labels): (&TriMesh, std::borrow::Cow<[i32]>) = if kept.len() == nt {
+            (mesh, labels_now.as_slice().into())
         } else {
             sub = compact(
                 &mesh.vertices.positions,
                 kept.iter().map(|&t| mesh.faces[t as usize]).collect(),
             )?;
-            (&sub, kept.iter().map(|&t| labels_now[t as usize]).collect())
+            let labels: Vec<i32> = kept.iter().map(|&t| labels_now[t as usize]).collect();
+            (&sub, labels.into())
         };
         let refusal = |first: &str, why: String| {
             Error::InvalidInput(format!(
@@ -813,6 +814,8 @@ fn build(
             }
         }
     }
+    // The first vertex solved far from its mesh vertex, and how far.
+    let mut moved_far: Option<(usize, f64)> = None;
     for (v, (p, surfs)) in vertices.iter().zip(&at_vertex).enumerate() {
         let mesh_vertex = pos(topo.vertices[v]);
         let mut gap: f64 = 0.0;
@@ -821,7 +824,11 @@ fn build(
             note(d, mesh_vertex, surfs, &mut max_gap);
             gap = gap.max(d);
         }
-        if gap > limit || dist(*p, mesh_vertex) > MAX_MOVE * spacing {
+        let moved = dist(*p, mesh_vertex);
+        if moved > MAX_MOVE * spacing && moved_far.is_none() {
+            moved_far = Some((v, moved));
+        }
+        if gap > limit || moved > MAX_MOVE * spacing {
             failing.push(around[v].clone());
         }
     }
@@ -967,12 +974,7 @@ fn build(
     // nearly coaxial cylinders cross far away).
     let areas = face_areas(mesh);
     if !failing.is_empty() {
-        let message = match vertices
-            .iter()
-            .enumerate()
-            .map(|(v, p)| (v, dist(*p, pos(topo.vertices[v]))))
-            .find(|&(_, d)| d > MAX_MOVE * spacing)
-        {
+        let message = match moved_far {
             Some((v, moved)) => {
                 let at = pos(topo.vertices[v]);
                 let kinds: Vec<&str> = at_vertex[v].iter().map(|s| s.kind().name()).collect();
