@@ -69,7 +69,7 @@ pub fn run(g: &Global, a: &CurvatureArgs) -> anyhow::Result<()> {
             a.sharp_threshold
         )));
     }
-    let (mut geom, report) = super::load(g, &a.input)?;
+    let (mut geom, report) = super::load_shape(g, &a.input)?;
     if a.method == Method::Bezier && !geom.is_mesh() {
         return Err(usage(format!(
             "{}: the Bézier method needs a triangle mesh, and this file has no faces \

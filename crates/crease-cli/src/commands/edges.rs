@@ -146,7 +146,7 @@ pub fn run(g: &Global, a: &EdgesArgs) -> anyhow::Result<()> {
         }
         params.model = Some(std::sync::Arc::new(crease::meshfeat::SvmModel::read(path)?));
     }
-    let (geom, report) = super::load(g, &a.input)?;
+    let (geom, report) = super::load_shape(g, &a.input)?;
     let Some(mesh) = geom.into_mesh() else {
         anyhow::bail!(
             "{}: no faces; feature edges need a triangle mesh",

@@ -147,7 +147,7 @@ pub fn run(g: &Global, a: &FilletsArgs, network: bool) -> anyhow::Result<()> {
         crate::ui::ensure_not_input(s, &[&a.input])?;
     }
     let params = params(a)?;
-    let (geom, report) = super::load(g, &a.input)?;
+    let (geom, report) = super::load_shape(g, &a.input)?;
     let n_points = geom.points.len();
     let need = a.k.max(a.curvature_k) + 1;
     if n_points < need {

@@ -85,7 +85,7 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
         denoise_normals: !a.no_denoise,
     };
     params.validate().map_err(|e| usage(e.to_string()))?;
-    let (geom, report) = super::load(g, &a.input)?;
+    let (geom, report) = super::load_shape(g, &a.input)?;
     let n_points = geom.points.len();
     if n_points < a.k + 1 {
         anyhow::bail!(

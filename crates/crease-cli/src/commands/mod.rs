@@ -68,6 +68,25 @@ pub fn load(g: &Global, path: &Path) -> anyhow::Result<(Geometry, ReadReport)> {
     Ok((geom, report))
 }
 
+/// [`load`] for the commands that analyse a shape: refuses a file whose points all coincide
+/// (no neighbourhood, normal or surface is theirs), which would otherwise get meaningless
+/// answers.
+pub fn load_shape(g: &Global, path: &Path) -> anyhow::Result<(Geometry, ReadReport)> {
+    let (geom, report) = load(g, path)?;
+    let p = &geom.points.positions;
+    if let Some(first) = p.first() {
+        if p.len() > 1 && p.iter().all(|q| q == first) {
+            anyhow::bail!(
+                "{}: all {} points coincide (at {first:?}): no neighbourhood, normal or surface \
+                 is theirs",
+                path.display(),
+                p.len()
+            );
+        }
+    }
+    Ok((geom, report))
+}
+
 /// Writes `geom` to `path`, refusing to overwrite any of `inputs`.
 pub fn save(
     g: &Global,

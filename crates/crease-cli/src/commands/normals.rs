@@ -82,7 +82,7 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
         return Err(crate::ui::usage("-k must be at least 1"));
     }
     let t_read = Instant::now();
-    let (mut geom, report) = super::load(g, &a.input)?;
+    let (mut geom, report) = super::load_shape(g, &a.input)?;
     let t_read = t_read.elapsed().as_secs_f64();
     let n = geom.points.len();
     let had_normals = geom.points.normals.is_some();

@@ -80,7 +80,7 @@ pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
         ..Default::default()
     };
     params.validate().map_err(|e| usage(e.to_string()))?;
-    let (mut geom, _) = super::load(g, &a.input)?;
+    let (mut geom, _) = super::load_shape(g, &a.input)?;
     let start = Instant::now();
     let stage = Stage::start("B-rep: surfaces, faces, edges, vertices", g.quiet);
     let positions = if geom.is_mesh() {

@@ -75,7 +75,7 @@ pub fn run(g: &Global, a: &RunArgs) -> anyhow::Result<()> {
         crate::ui::ensure_not_input(&a.output.join(name), &[&a.input])?;
     }
     let start = Instant::now();
-    let (geom, report) = super::load(g, &a.input)?;
+    let (geom, report) = super::load_shape(g, &a.input)?;
     let mut summary = if geom.is_mesh() {
         run_mesh(g, a, geom)?
     } else {

@@ -84,7 +84,7 @@ pub fn run(g: &Global, a: &SegmentArgs) -> anyhow::Result<()> {
     }
     .validate()
     .map_err(|e| usage(e.to_string()))?;
-    let (mut geom, report) = super::load(g, &a.input)?;
+    let (mut geom, report) = super::load_shape(g, &a.input)?;
     if !geom.is_mesh() {
         return run_cloud(g, a, geom, report.dropped_nonfinite, &params);
     }

@@ -106,7 +106,7 @@ pub fn run(g: &Global, a: &SharpArgs) -> anyhow::Result<()> {
         });
     }
     params.validate().map_err(|e| usage(e.to_string()))?;
-    let (mut geom, report) = super::load(g, &a.input)?;
+    let (mut geom, report) = super::load_shape(g, &a.input)?;
     let n = geom.points.len();
     let on_mesh = geom.is_mesh() && !a.points_only;
     let start = Instant::now();

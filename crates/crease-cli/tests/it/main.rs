@@ -7,6 +7,7 @@ mod common;
 
 mod cli;
 mod curvature_cli;
+mod degenerate_cli;
 mod edges_cli;
 mod eval_cli;
 mod fillets_cli;

@@ -44,6 +44,46 @@ fn las_err(path: &Path, what: &str, e: las::Error) -> Error {
     Error::format(path, format!("{what}: {e}"))
 }
 
+/// Checks a LAZ file's chunk table before the decoder allocates it: the `laz` crate reserves
+/// 16 bytes per chunk the table announces, so a corrupt count of 2^31 chunks made it allocate
+/// 32 GB and abort (found by mutation fuzzing). Every chunk holds at least one byte of the
+/// compressed data between the point data's start and the table, which bounds the count.
+fn check_chunk_table(path: &Path, data_start: u64, file_len: u64) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let corrupt = |what: String| Error::format(path, format!("corrupt LAZ chunk table: {what}"));
+    let mut f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut word = [0u8; 8];
+    let read_at = |f: &mut std::fs::File, at: u64, buf: &mut [u8]| -> Result<()> {
+        f.seek(SeekFrom::Start(at))
+            .and_then(|_| f.read_exact(buf))
+            .map_err(|_| corrupt(format!("cannot read {} bytes at byte {at}", buf.len())))
+    };
+    read_at(&mut f, data_start, &mut word)?;
+    let mut table = i64::from_le_bytes(word);
+    if table == -1 {
+        // Written by a streaming encoder: the offset is in the file's last 8 bytes.
+        read_at(&mut f, file_len.saturating_sub(8), &mut word)?;
+        table = i64::from_le_bytes(word);
+    }
+    let table = u64::try_from(table).unwrap_or(u64::MAX);
+    if table < data_start + 8 || table.saturating_add(8) > file_len {
+        return Err(corrupt(format!(
+            "its offset {table} lies outside the compressed data (bytes {} to {file_len})",
+            data_start + 8
+        )));
+    }
+    let mut head = [0u8; 8];
+    read_at(&mut f, table, &mut head)?;
+    let chunks = u64::from(u32::from_le_bytes([head[4], head[5], head[6], head[7]]));
+    let room = table - (data_start + 8);
+    if chunks > room {
+        return Err(corrupt(format!(
+            "it announces {chunks} chunks, but only {room} bytes of compressed data precede it"
+        )));
+    }
+    Ok(())
+}
+
 /// Reads a LAS or LAZ file (see the module documentation).
 pub fn read(path: &Path) -> Result<(Geometry, ReadReport)> {
     // The decoder is a third-party crate: a panic inside it on a corrupt file becomes an error.
@@ -70,6 +110,9 @@ fn read_inner(path: &Path) -> Result<(Geometry, ReadReport)> {
             )
         })?
     };
+    if raw.point_data_record_format & 0x80 != 0 {
+        check_chunk_table(path, u64::from(raw.offset_to_point_data), file_len)?;
+    }
     let mut reader =
         Reader::from_path(path).map_err(|e| las_err(path, "cannot open the LAS/LAZ file", e))?;
     let header = reader.header().clone();

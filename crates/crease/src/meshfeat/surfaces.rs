@@ -119,7 +119,13 @@ fn vertex_surfaces(
     if pts.len() <= pp.k.max(pp.normal_k) + 1 || flat {
         return Ok(None);
     }
-    let seg = segment_points(&pts, None, &SegmentParams::default(), &pp)?;
+    // Vertices the point segmentation refuses (on one line, say: a strip of slivers) give no
+    // evidence; the edges are scored without it.
+    let seg = match segment_points(&pts, None, &SegmentParams::default(), &pp) {
+        Ok(seg) => seg,
+        Err(crate::Error::InvalidInput(_)) => return Ok(None),
+        Err(e) => return Err(e),
+    };
     let surfaces: Vec<crate::geometry::SurfaceParams> =
         seg.surfaces.iter().map(|s| s.params).collect();
     let mut label = vec![-1i32; n];

@@ -75,6 +75,10 @@ use crate::{Error, Result};
 
 use crate::geometry::surface::signed_distance;
 
+/// Points whose mean graph edge is longer than this many times the median one (isolated
+/// outliers) do not count in the mean edge length, the segmentation's unit of length.
+const OUTLIER_EDGE: f64 = 10.0;
+
 /// Parameters of the point-cloud path (the thresholds are those of [`SegmentParams`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointParams {
@@ -297,6 +301,52 @@ fn check_neighbours(points: &[Point3], nbrs: &Neighborhoods, k: usize) -> Result
     Ok(())
 }
 
+/// Errors when the points lie on one line: every plane through it fits them, so no surface is
+/// theirs. Decided on neighbourhoods (their spread across below 1e-6 of their spread along:
+/// the closed-form eigenvalues are exact to about 1e-16 of the largest, not relatively),
+/// so that a far outlier, which makes the whole cloud look like a line, does not count: up to
+/// 256 evenly spaced points of the (spatially sorted) cloud, each with its first k
+/// neighbours; one neighbourhood that is not a line is enough.
+fn check_not_collinear(points: &[Point3], nbrs: &Neighborhoods, k: usize) -> Result<()> {
+    const SAMPLES: usize = 256;
+    let n = points.len();
+    let step = n.div_ceil(SAMPLES).max(1);
+    let spread = |i: usize| -> bool {
+        let row = nbrs.prefix(i, k);
+        let m = (row.len() + 1) as f64;
+        let all = || std::iter::once(points[i]).chain(row.iter().map(|&j| points[j as usize]));
+        let mut c = [0.0; 3];
+        for p in all() {
+            for a in 0..3 {
+                c[a] += p[a] / m;
+            }
+        }
+        let mut cov = [0.0; 6];
+        for p in all() {
+            let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+            let terms = [
+                d[0] * d[0],
+                d[0] * d[1],
+                d[0] * d[2],
+                d[1] * d[1],
+                d[1] * d[2],
+                d[2] * d[2],
+            ];
+            for (s, t) in cov.iter_mut().zip(terms) {
+                *s += t;
+            }
+        }
+        let (_, ev) = crate::estimate::normals::smallest_eigen(cov);
+        ev[2] > 0.0 && ev[1] > 1e-12 * ev[2]
+    };
+    if (0..n).step_by(step).any(spread) {
+        return Ok(());
+    }
+    Err(Error::InvalidInput(
+        "point segmentation: the points lie on one line, so no surface is theirs".into(),
+    ))
+}
+
 /// The point path after the neighbours and normals: `vnormal` are unit normals, one per point
 /// (`normals_given` is reported), `nbrs` holds at least `pp.k` neighbours per row.
 pub(crate) fn segment_core(
@@ -309,6 +359,7 @@ pub(crate) fn segment_core(
 ) -> Result<PointSegmentation> {
     check_point_params(params, pp)?;
     check_neighbours(points, nbrs, pp.k)?;
+    check_not_collinear(points, nbrs, pp.k)?;
     if vnormal.len() != points.len() {
         return Err(Error::InvalidArgument(format!(
             "point segmentation: {} normals for {} points",
@@ -353,8 +404,27 @@ pub(crate) fn segment_core(
             (s, row.len())
         })
         .collect();
+    // The mean over points whose own mean edge is within OUTLIER_EDGE times the median: one
+    // point 1e19 away (its edges 1e19 long) made the plain mean 1e15 and merged a cube's faces.
+    let mut per_point: Vec<f64> = edge_means
+        .iter()
+        .filter(|&&(_, c)| c > 0)
+        .map(|&(s, c)| s / c as f64)
+        .collect();
+    let cut = if per_point.is_empty() {
+        f64::INFINITY
+    } else {
+        let mid = per_point.len() / 2;
+        let (_, m, _) = per_point.select_nth_unstable_by(mid, f64::total_cmp);
+        if *m > 0.0 {
+            OUTLIER_EDGE * *m
+        } else {
+            f64::INFINITY
+        }
+    };
     let (sum, cnt) = edge_means
         .iter()
+        .filter(|&&(s, c)| c > 0 && s / c as f64 <= cut)
         .fold((0.0, 0usize), |(s, c), &(a, b)| (s + a, c + b));
     let l = sum / cnt.max(1) as f64;
     if !l.is_finite() {
@@ -369,7 +439,15 @@ pub(crate) fn segment_core(
             "point segmentation: the points are all coincident".into(),
         ));
     }
-    let diag = Aabb::from_points(points)
+    // The extent of the part, outliers left out as above (the curvature threshold is scaled by
+    // it: a point 1e19 away made it 5e-20, and every curved label a plane's).
+    let inliers: Vec<Point3> = points
+        .iter()
+        .zip(&edge_means)
+        .filter(|&(_, &(s, c))| c > 0 && s / c as f64 <= cut)
+        .map(|(p, _)| *p)
+        .collect();
+    let diag = Aabb::from_points(if inliers.is_empty() { points } else { &inliers })
         .map(|b| b.diagonal())
         .filter(|d| *d > 0.0)
         .ok_or_else(|| Error::InvalidInput("point segmentation: the cloud has no extent".into()))?;

@@ -210,6 +210,28 @@ fn knn_equals_brute_force_with_duplicates_and_ties() {
 }
 
 #[test]
+fn crowded_blocks_and_repeated_points_stay_exact() {
+    // One point 1e9 away stretches the quantiser: the cube's points share one cell and every
+    // query's candidates are the whole cube (selected, not sorted: was quadratic).
+    let mut p = surface("cube", 2000, 5);
+    p.push([1e9, 0.1, 0.2]);
+    for k in [1, 8, 20] {
+        assert_knn_exact(&p, k, "cube and a far outlier");
+    }
+    // Half the points repeated at one place, the others spread.
+    let mut p = surface("sphere", 600, 6);
+    p.extend(std::iter::repeat_n([0.3, 0.1, -0.2], 600));
+    assert_knn_exact(&p, 12, "half at one place");
+    // Every point at one place: the k smallest other indices, answered without a search.
+    let same = vec![[1.5, 2.5, 3.5]; 200_000];
+    let nb = knn(&same, 8).unwrap();
+    for i in [0usize, 3, 8, 9, 123_456, 199_999] {
+        let expect: Vec<u32> = (0..=8u32).filter(|&j| j as usize != i).take(8).collect();
+        assert_eq!(nb.of(i), &expect[..], "point {i}");
+    }
+}
+
+#[test]
 fn knn_handles_outliers_and_uneven_density() {
     // A dense surface plus far outliers: the outliers' searches leave the grid's shells.
     let mut p = surface("sphere", 3000, 4);
