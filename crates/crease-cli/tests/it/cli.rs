@@ -685,7 +685,7 @@ fn error_messages_quote_short_excerpts() {
 #[test]
 fn a_killed_convert_never_leaves_a_truncated_output() {
     let dir = tempfile::tempdir().unwrap();
-    let input = common::synth(dir.path(), &["synth", "cube", "-n", "300000"], "cube.ply");
+    let input = common::synth(dir.path(), &["synth", "cube", "-n", "1000000"], "cube.ply");
     let (src, _) = crease::io::read(&input, &Default::default()).unwrap();
     let out = dir.path().join("copy.xyz");
     // A complete previous output.
@@ -696,7 +696,8 @@ fn a_killed_convert_never_leaves_a_truncated_output() {
         .assert()
         .success();
     let previous = std::fs::read(&out).unwrap();
-    for delay_ms in [5u64, 20, 60, 150, 400] {
+    // 1M points: the kills land while reading, computing and writing.
+    for delay_ms in [5u64, 60, 400, 1000, 2000] {
         let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("crease"))
             .args(["convert", "-q"])
             .arg(&input)
