@@ -70,20 +70,11 @@ pub fn load(g: &Global, path: &Path) -> anyhow::Result<(Geometry, ReadReport)> {
 
 /// [`load`] for the commands that analyse a shape: refuses a file whose points all coincide
 /// (no neighbourhood, normal or surface is theirs), which would otherwise get meaningless
-/// answers.
+/// answers, or span so little or so much that squared distances leave f64's range.
 pub fn load_shape(g: &Global, path: &Path) -> anyhow::Result<(Geometry, ReadReport)> {
     let (geom, report) = load(g, path)?;
-    let p = &geom.points.positions;
-    if let Some(first) = p.first() {
-        if p.len() > 1 && p.iter().all(|q| q == first) {
-            anyhow::bail!(
-                "{}: all {} points coincide (at {first:?}): no neighbourhood, normal or surface \
-                 is theirs",
-                path.display(),
-                p.len()
-            );
-        }
-    }
+    crease::spatial::check_shape(&geom.points.positions)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     Ok((geom, report))
 }
 

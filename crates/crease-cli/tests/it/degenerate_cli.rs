@@ -220,3 +220,38 @@ fn degenerate_meshes_get_answers() {
     let surface = &seg.face_attributes.get("surface").unwrap().values;
     assert!(surface.iter().all(|&s| s == 0.0));
 }
+
+/// The sharp-edge count `crease edges` reports ("N of M edges sharp").
+fn sharp_edges(input: &Path) -> usize {
+    let (code, err) = run("edges", "ply", input);
+    assert_eq!(code, 0, "{err}");
+    let line = err.lines().find(|l| l.contains("edges sharp")).unwrap();
+    let n = line.split(": ").nth(1).unwrap().split(' ').next().unwrap();
+    n.parse().unwrap()
+}
+
+#[test]
+fn one_huge_face_leaves_the_mesh_edges_as_they_are() {
+    // One triangle 1e20 wide beside a cube of 19,200: it holds almost all the area, so the
+    // area-based ball budget of the edge features predicted a few items per ball where every
+    // ball held the whole cube (fuzzed STL files of that kind took 8 to 98 s); the counted
+    // crowding sets the budget now.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cube = common::synth(d, &["synth", "cube", "--mesh", "-n", "20000"], "cube.obj");
+    let text = std::fs::read_to_string(&cube).unwrap();
+    let n = text.lines().filter(|l| l.starts_with("v ")).count();
+    let huge = d.join("huge.obj");
+    std::fs::write(
+        &huge,
+        format!(
+            "{text}v 1e20 0 0\nv 0 1e20 0\nv 0 0 1e20\nf {} {} {}\n",
+            n + 1,
+            n + 2,
+            n + 3
+        ),
+    )
+    .unwrap();
+    // The cube's sharp edges, plus the huge triangle's three border edges.
+    assert_eq!(sharp_edges(&huge), sharp_edges(&cube) + 3);
+}

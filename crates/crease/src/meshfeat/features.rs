@@ -50,7 +50,9 @@ use nalgebra::{Matrix3, SymmetricEigen};
 use rayon::prelude::*;
 
 use super::grid::BallGrid;
-use super::tangent::{subset_level, tangent_angles, TangentParams, PAPER_SCALES};
+use super::tangent::{
+    crowd_counts, expected_items, subset_level, tangent_angles, TangentParams, PAPER_SCALES,
+};
 use super::EdgeMesh;
 use crate::geometry::{vec3, Point3};
 use crate::{Error, Result};
@@ -163,14 +165,16 @@ struct EdgeItem {
 }
 
 /// Level per radius: the finest l at which a ball of radius r holds at most `budget` items on
-/// average, `density` items per unit area.
-fn levels_for(radii: &[f64], density: f64, budget: Option<usize>) -> Vec<u32> {
+/// average, `density` items per unit area, or `measured[s]` ([`crowd_counts`]) where that is
+/// much more than the area predicts ([`expected_items`]).
+fn levels_for(radii: &[f64], density: f64, measured: &[f64], budget: Option<usize>) -> Vec<u32> {
     radii
         .iter()
-        .map(|&r| match budget {
+        .zip(measured)
+        .map(|(&r, &m)| match budget {
             None => 0,
             Some(b) => {
-                let expected = std::f64::consts::PI * r * r * density;
+                let expected = expected_items(r, std::f64::consts::PI * r * r * density, m);
                 let mut l = 0;
                 while l < 40 && expected / f64::powi(2.0, l as i32) > b.max(1) as f64 {
                     l += 1;
@@ -268,7 +272,20 @@ fn vertex_curvatures(em: &EdgeMesh, radii: &[f64], params: &FeatureParams) -> Ve
     } else {
         0.0
     };
-    let levels = levels_for(radii, density, params.max_items);
+    let edges = topo.edges();
+    let measured = match params.max_items {
+        Some(_) => crowd_counts(
+            p,
+            ne,
+            |e| {
+                let [a, b] = edges[e];
+                vec3::lerp(p[a as usize], p[b as usize], 0.5)
+            },
+            radii,
+        ),
+        None => vec![0.0; ns],
+    };
+    let levels = levels_for(radii, density, &measured, params.max_items);
     let groups = group_by_level(radii, &levels);
     let edge_levels: Vec<u32> = (0..ne as u32).into_par_iter().map(subset_level).collect();
     let grids: Vec<(BallGrid<EdgeItem>, Vec<usize>)> = groups
@@ -357,7 +374,11 @@ fn vertex_saliency(em: &EdgeMesh, radii: &[f64], h: &[f64], params: &FeaturePara
     } else {
         0.0
     };
-    let levels = levels_for(radii, density, params.max_items);
+    let measured = match params.max_items {
+        Some(_) => crowd_counts(p, nv, |v| p[v], radii),
+        None => vec![0.0; ns],
+    };
+    let levels = levels_for(radii, density, &measured, params.max_items);
     let groups = group_by_level(radii, &levels);
     let grids: Vec<(BallGrid<f64>, Vec<usize>)> = groups
         .iter()

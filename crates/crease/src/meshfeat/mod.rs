@@ -138,13 +138,16 @@ pub struct EdgeMesh<'a> {
 
 impl<'a> EdgeMesh<'a> {
     /// Prepares `mesh`. Errors: face indices out of range, a mesh too large for the topology,
-    /// no faces, non-finite coordinates.
+    /// no faces, non-finite coordinates, a span outside [`crate::spatial::check_extent`]'s.
     pub fn new(mesh: &'a TriMesh) -> Result<EdgeMesh<'a>> {
         if mesh.faces.is_empty() {
             return Err(Error::InvalidInput(
                 "feature edges need a triangle mesh, but there are no faces".into(),
             ));
         }
+        // A vertex 1e308 away: lengths and areas overflow, and the ball searches of every
+        // feature hold the whole mesh (a fuzzed 19k-face STL took 98 s).
+        crate::spatial::check_extent(mesh.positions())?;
         if let Some(i) = mesh
             .positions()
             .iter()

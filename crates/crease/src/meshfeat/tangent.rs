@@ -196,6 +196,57 @@ fn face_grid(em: &EdgeMesh, faces: &[u32], cell: f64) -> FaceGrid {
     BallGrid::new(items, cell)
 }
 
+/// Vertices around which [`crowd_counts`] counts the items of a ball.
+pub(crate) const CROWD_SAMPLES: usize = 16;
+/// A measured ball holding more than this many times the items the area predicts sets the level.
+pub(crate) const CROWD_FACTOR: f64 = 8.0;
+
+/// Items (`n` of them, `item(i)` their positions) within each radius of [`CROWD_SAMPLES`]
+/// evenly spaced `centres`, on average. The area-based estimate of [`levels_for`] fails where a
+/// few huge faces hold most of the area and the items crowd elsewhere (corrupt or degenerate
+/// meshes: a fuzzed 19k-face STL took 23 s, every ball holding every edge); this count catches
+/// it, at 16 distance computations per item.
+pub(crate) fn crowd_counts(
+    centres: &[Point3],
+    n: usize,
+    item: impl Fn(usize) -> Point3 + Sync,
+    radii: &[f64],
+) -> Vec<f64> {
+    if centres.is_empty() {
+        return vec![0.0; radii.len()];
+    }
+    let picks: Vec<Point3> = (0..CROWD_SAMPLES)
+        .map(|i| centres[i * centres.len() / CROWD_SAMPLES])
+        .collect();
+    let counts: Vec<Vec<usize>> = picks
+        .par_iter()
+        .map(|&q| {
+            let mut c = vec![0usize; radii.len()];
+            for i in 0..n {
+                let d2 = vec3::dist2(item(i), q);
+                for (cs, &r) in c.iter_mut().zip(radii) {
+                    *cs += usize::from(d2 <= r * r);
+                }
+            }
+            c
+        })
+        .collect();
+    (0..radii.len())
+        .map(|s| counts.iter().map(|c| c[s]).sum::<usize>() as f64 / CROWD_SAMPLES as f64)
+        .collect()
+}
+
+/// The items a ball of radius `r` holds: `by_area` (the area's prediction), or `measured`
+/// ([`crowd_counts`]) where that is more than [`CROWD_FACTOR`] times it.
+pub(crate) fn expected_items(r: f64, by_area: f64, measured: f64) -> f64 {
+    if measured > CROWD_FACTOR * by_area {
+        tracing::debug!("balls of radius {r:e} hold {measured} items, not {by_area}");
+        measured
+    } else {
+        by_area
+    }
+}
+
 /// The level of a face: leading zero bits of a SplitMix64 hash of its id (level ≥ l holds a
 /// fraction 2⁻ˡ of the faces, independently of the mesh's face order statistics).
 pub(crate) fn subset_level(f: u32) -> u32 {
@@ -270,15 +321,22 @@ pub fn tangent_angles(em: &EdgeMesh, params: &TangentParams) -> Result<TangentAn
     let mean_area = if nf > 0 { total_area / nf as f64 } else { 0.0 };
     let face_levels: Vec<u32> = (0..nf as u32).into_par_iter().map(subset_level).collect();
     let max_level = 40u32;
+    let measured = match params.max_faces {
+        Some(_) => crowd_counts(em.mesh.positions(), nf, |f| em.centroids[f], &radii),
+        None => vec![0.0; ns],
+    };
     let levels: Vec<u32> = radii
         .iter()
-        .map(|&r| match params.max_faces {
+        .zip(&measured)
+        .map(|(&r, &m)| match params.max_faces {
             None => 0,
             Some(budget) => {
-                if mean_area <= 0.0 {
-                    return 0;
-                }
-                let expected = std::f64::consts::PI * r * r / mean_area;
+                let by_area = if mean_area > 0.0 {
+                    std::f64::consts::PI * r * r / mean_area
+                } else {
+                    0.0
+                };
+                let expected = expected_items(r, by_area, m);
                 let mut l = 0;
                 while l < max_level && expected / f64::powi(2.0, l as i32) > budget as f64 {
                     l += 1;

@@ -180,7 +180,7 @@ const EXTENT_RANGE: (f64, f64) = (1e-140, 1e150);
 
 /// Errors when the points span so little (but not nothing) or so much that squared distances
 /// leave f64's normal range ([`EXTENT_RANGE`]).
-pub(crate) fn check_extent(points: &[Point3]) -> Result<()> {
+pub fn check_extent(points: &[Point3]) -> Result<()> {
     let (lo, hi) = points
         .par_iter()
         .fold(
@@ -217,6 +217,22 @@ pub(crate) fn check_extent(points: &[Point3]) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// Errors when the points all coincide (no neighbourhood, normal or surface is theirs) or
+/// span outside [`check_extent`]'s range: the check every command of the CLI (and every
+/// function of the Python package) that analyses a shape makes on its input first.
+pub fn check_shape(points: &[Point3]) -> Result<()> {
+    if let Some(first) = points.first() {
+        if points.len() > 1 && points.iter().all(|q| q == first) {
+            return Err(Error::InvalidInput(format!(
+                "all {} points coincide (at {first:?}): no neighbourhood, normal or surface is \
+                 theirs",
+                points.len()
+            )));
+        }
+    }
+    check_extent(points)
 }
 
 /// Errors on the first point with a non-finite coordinate.

@@ -13,7 +13,8 @@ pub mod spacing;
 pub use graph::Adjacency;
 pub use kdtree::KdIndex;
 pub use knn::{
-    knn, knn_map, knn_map_set, knn_map_set_unzip, knn_with, KnnMethod, KnnQuery, Neighborhoods,
+    check_extent, check_shape, knn, knn_map, knn_map_set, knn_map_set_unzip, knn_with, KnnMethod,
+    KnnQuery, Neighborhoods,
 };
 pub use morton::morton_order;
 pub use radius::{knn_within, radius_neighbors};
