@@ -167,19 +167,20 @@ pub fn vertex_labels(
     let step = p.torus_step;
     let bin = |i: usize| (kmax[i] * mean_edge / step).round() as i64;
     let mut bins: Vec<i64> = (0..nv)
-        .filter(|&i| labels[i] == label::OTHER)
+        .filter(|&i| labels[i] == label::OTHER && kmax[i].is_finite())
         .map(bin)
         .collect();
     bins.sort_unstable();
+    // Saturating: a huge κ̃_max (a degenerate mesh) bins at i64::MAX.
     let count = |b: i64| -> usize {
-        let lo = bins.partition_point(|&x| x < b - 1);
-        let hi = bins.partition_point(|&x| x <= b + 1);
+        let lo = bins.partition_point(|&x| x < b.saturating_sub(1));
+        let hi = bins.partition_point(|&x| x <= b.saturating_add(1));
         hi - lo
     };
     let th = p.torus_fraction * nv as f64;
     let torus: Vec<bool> = (0..nv)
         .into_par_iter()
-        .map(|i| labels[i] == label::OTHER && count(bin(i)) as f64 > th)
+        .map(|i| labels[i] == label::OTHER && kmax[i].is_finite() && count(bin(i)) as f64 > th)
         .collect();
     for (l, t) in labels.iter_mut().zip(torus) {
         if t {

@@ -11,6 +11,7 @@ mod brep;
 mod curvature;
 mod eval;
 mod fillets;
+mod fuzz_found;
 mod io_pcd_las_e57;
 mod io_ply;
 mod io_text_formats;
