@@ -21,7 +21,7 @@ use numpy::{PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crease::analysis::AnalysisParams;
+use crease::analysis::{AnalysisParams, CloudAnalysis};
 use crease::estimate::{self, PcaParams, Weighting};
 use crease::fillets::{
     curve_network, extract_fillets, FilletParams, Label, Search, ThresholdCount,
@@ -31,7 +31,7 @@ use crease::io::{Geometry, ReadOptions, WriteOptions};
 use crease::lines::{extract_lines, LinesParams};
 use crease::meshfeat::{detect_edges, feature_polylines, EdgeMethod, EdgeParams};
 use crease::segment::{segment_mesh, segment_points, PointParams, SegmentParams};
-use crease::sharp::{detect_mesh, detect_points_with, Measure, SharpParams, ThresholdRule};
+use crease::sharp::{detect, detect_mesh, Measure, SharpParams, ThresholdRule};
 
 use convert::{
     attribute_of, attributes_dict, check_shape, compute, faces_of, index_array, json_to_py,
@@ -338,11 +338,8 @@ fn sharp<'py>(
     let (pos, faces) = shape_input(&points, faces.as_ref())?;
     let n = pos.len();
     let on_mesh = faces.as_ref().is_some_and(|f| !f.is_empty());
-    let kmax = params
-        .scales
-        .as_ref()
-        .and_then(|s| s.iter().copied().max())
-        .unwrap_or(crease::sharp::CLOUD_SCALES[7]);
+    let ap = crease::sharp::analysis_params(&params).map_err(|e| to_py_err(py, e))?;
+    let kmax = ap.max_k;
     if !on_mesh && n < kmax + 1 {
         return Err(value_error(format!(
             "{n} points, sharp features at k = {kmax} need at least {}",
@@ -356,16 +353,13 @@ fn sharp<'py>(
             let mesh = TriMesh::new(pos, faces.unwrap_or_default())?;
             detect_mesh(&mesh, &params)?
         } else {
+            // As the CLI: the analysis (distinct points in Morton order), its neighbour
+            // lists timed apart, then the detection.
             let t = Instant::now();
-            let spatial = crease::sharp::spatial_order(&pos);
-            let pts = spatial.as_ref().map_or(&pos, |(_, sorted)| sorted);
-            let nbrs = crease::spatial::knn(pts, kmax)?;
+            let analysis = CloudAnalysis::new(&pos, ap)?;
+            analysis.neighbours()?;
             knn_seconds = Some(t.elapsed().as_secs_f64());
-            let r = detect_points_with(pts, &nbrs, &params)?;
-            match &spatial {
-                Some((order, _)) => r.to_input_order(order)?,
-                None => r,
-            }
+            detect(&analysis, &params)?
         };
         Ok((result, start.elapsed().as_secs_f64(), knn_seconds))
     })?;

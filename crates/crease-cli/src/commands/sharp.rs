@@ -8,8 +8,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
+use crease::analysis::CloudAnalysis;
 use crease::geometry::{Attribute, TriMesh};
-use crease::sharp::{detect_mesh, detect_points_with, Measure, SharpParams, ThresholdRule};
+use crease::sharp::{detect, detect_mesh, Measure, SharpParams, ThresholdRule};
 
 use crate::args::Global;
 use crate::ui::{usage, Stage};
@@ -136,11 +137,9 @@ pub fn run(g: &Global, a: &SharpArgs) -> anyhow::Result<()> {
         geom.face_attributes = mesh.face_attributes;
         r
     } else {
-        let kmax = params
-            .scales
-            .as_ref()
-            .and_then(|s| s.iter().copied().max())
-            .unwrap_or(crease::sharp::CLOUD_SCALES[7]);
+        let ap = crease::sharp::analysis_params(&params)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+        let kmax = ap.max_k;
         if n < kmax + 1 {
             anyhow::bail!(
                 "{}: {n} points, sharp features at k = {kmax} need at least {}",
@@ -149,19 +148,14 @@ pub fn run(g: &Global, a: &SharpArgs) -> anyhow::Result<()> {
             );
         }
         // One kNN query at the largest scale serves every scale; timed apart for --json. The
-        // detection runs on the points in Morton order (cache-friendly neighbour reads, see
-        // `crease::sharp::spatial_order`) and its result is mapped back to the input order.
+        // analysis holds the distinct points in Morton order (cache-friendly neighbour reads)
+        // and the result is mapped back to the input order.
         let t = Instant::now();
-        let pos = &geom.points.positions;
-        let spatial = crease::sharp::spatial_order(pos);
-        let pts = spatial.as_ref().map_or(pos, |(_, sorted)| sorted);
-        let nbrs = crease::spatial::knn(pts, kmax)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+        let in_file = |e: crease::Error| anyhow::anyhow!("{}: {e}", a.input.display());
+        let analysis = CloudAnalysis::new(&geom.points.positions, ap).map_err(in_file)?;
+        analysis.neighbours().map_err(in_file)?;
         knn_seconds = Some(t.elapsed().as_secs_f64());
-        detect_points_with(pts, &nbrs, &params).and_then(|r| match &spatial {
-            Some((order, _)) => r.to_input_order(order),
-            None => Ok(r),
-        })
+        detect(&analysis, &params)
     }
     .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
     stage.finish();

@@ -255,3 +255,50 @@ fn one_huge_face_leaves_the_mesh_edges_as_they_are() {
     // The cube's sharp edges, plus the huge triangle's three border edges.
     assert_eq!(sharp_edges(&huge), sharp_edges(&cube) + 3);
 }
+
+#[test]
+fn exact_duplicates_are_analysed_once() {
+    // A cube sampled twice over, the copy in reverse order (a scanner's repeated returns): every
+    // copy gets its original's labels, and the lines are those of the cube sampled once (before,
+    // the copies filled the neighbourhoods with zero-length edges: 8 planes instead of 6, 632
+    // sharp points instead of twice 397).
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cube = cube_points(d);
+    let n = cube.len();
+    let clean = write_xyz(&d.join("clean.xyz"), &cube);
+    let mut twice = cube.clone();
+    twice.extend(cube.iter().rev());
+    let twice = write_xyz(&d.join("twice.xyz"), &twice);
+    for input in [&clean, &twice] {
+        for (cmd, ext) in [("sharp", "ply"), ("segment", "ply"), ("network", "obj")] {
+            let (code, err) = run(cmd, ext, input);
+            assert_eq!(code, 0, "{cmd}: {err}");
+        }
+    }
+    let attribute = |f: &str, name: &str| -> Vec<f64> {
+        let (g, _) = crease::io::read(d.join(f), &Default::default()).unwrap();
+        g.points.attribute(name).unwrap().values.clone()
+    };
+    for (f, name) in [
+        ("sharp", "sharp"),
+        ("sharp", "sharpness"),
+        ("segment", "surface"),
+    ] {
+        let once = attribute(&format!("clean-{f}.ply"), name);
+        let both = attribute(&format!("twice-{f}.ply"), name);
+        assert_eq!(&both[..n], &once[..], "{name}");
+        let copy: Vec<f64> = both[n..].iter().rev().copied().collect();
+        assert_eq!(copy, once, "{name} of the copies");
+    }
+    let planes: std::collections::BTreeSet<i64> = attribute("twice-segment.ply", "surface")
+        .iter()
+        .map(|&s| s as i64)
+        .filter(|&s| s >= 0)
+        .collect();
+    assert_eq!(planes.len(), 6);
+    assert_eq!(
+        std::fs::read(d.join("twice-network.obj")).unwrap(),
+        std::fs::read(d.join("clean-network.obj")).unwrap()
+    );
+}

@@ -22,6 +22,12 @@
 //! builds it once for the whole curve network. [`CloudAnalysis::counts`] tells how often each piece was
 //! computed (once at most: a test holds the whole `crease run` to it).
 //!
+//! Exact duplicate points (a cloud sampled twice over, a scanner's repeated returns: 40 % of a
+//! handheld LiDAR scan) are analysed once: the analysis holds the distinct points, and
+//! [`CloudAnalysis::to_input_order`] gives every duplicate its first copy's value. Counted as
+//! separate samples they would fill neighbourhoods with zero-length edges (a cube sampled
+//! twice was segmented into 8 planes).
+//!
 //! The pieces are computed on first use, one at a time, on the calling thread's rayon pool;
 //! an analysis is `Sync`, but a piece asked for by two threads at once may be computed twice
 //! (both results are identical; one is kept).
@@ -37,7 +43,7 @@ use crate::segment::{
     estimated_normals, neighbours_needed, segment_core, PointParams, PointSegmentation,
     SegmentParams,
 };
-use crate::spatial::{knn, morton_order, Neighborhoods};
+use crate::spatial::{knn, morton_order_unique, Neighborhoods};
 use crate::{Error, Result};
 
 /// The default neighbour count of the one query: the largest scale of
@@ -68,15 +74,27 @@ impl Default for AnalysisParams {
 }
 
 impl AnalysisParams {
-    /// Errors (`InvalidArgument`) on invalid segmentation settings or a `max_k` below the
-    /// neighbours the segmentation reads.
+    /// Errors (`InvalidArgument`) on invalid segmentation settings or a zero `max_k`. A
+    /// `max_k` below what the normals or the segmentation read ([`neighbours_needed`]) is an
+    /// error when they are asked for (a stage that reads fewer neighbours need not pay for them).
     pub fn validate(&self) -> Result<()> {
         self.segment.validate()?;
         self.points.validate()?;
-        let need = neighbours_needed(&self.points, false);
+        if self.max_k == 0 {
+            return Err(Error::InvalidArgument(
+                "analysis: max_k must be positive".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Errors when the neighbour lists are shorter than the normals (`normals_given` false) or
+    /// the segmentation read.
+    fn check_needed(&self, normals_given: bool, what: &str) -> Result<()> {
+        let need = neighbours_needed(&self.points, normals_given);
         if self.max_k < need {
             return Err(Error::InvalidArgument(format!(
-                "analysis: max_k = {} is smaller than the {need} neighbours the segmentation reads",
+                "analysis: max_k = {} is smaller than the {need} neighbours {what} reads",
                 self.max_k
             )));
         }
@@ -105,13 +123,17 @@ struct Counters {
     segmentations: AtomicUsize,
 }
 
-/// The shared analysis of one point cloud (see the module documentation). The points are held
-/// in Morton order: `points()[r]` is input point `order()[r]`; per-point pieces follow that
-/// order, and the stages map their results back to the input order.
+/// The shared analysis of one point cloud (see the module documentation). The distinct points
+/// are held in Morton order: `points()[r]` is input point `order()[r]` (the first of its
+/// duplicates); per-point pieces follow that order, and the stages map their results back to
+/// the input order ([`CloudAnalysis::to_input_order`]).
 #[derive(Debug)]
 pub struct CloudAnalysis {
     params: AnalysisParams,
     order: Vec<u32>,
+    /// `rank[i]`: the row of input point i; empty when there are no duplicates (`order` is then
+    /// a permutation).
+    rank: Vec<u32>,
     points: Vec<Point3>,
     neighbours: OnceLock<Neighborhoods>,
     noise: OnceLock<f64>,
@@ -126,7 +148,7 @@ impl CloudAnalysis {
     /// but the spatial order.
     ///
     /// Errors: invalid settings ([`AnalysisParams::validate`]), fewer than `max_k + 1`
-    /// points, a non-finite coordinate.
+    /// distinct points, a non-finite coordinate.
     pub fn new(points: &[Point3], params: AnalysisParams) -> Result<CloudAnalysis> {
         params.validate()?;
         if points.len() <= params.max_k {
@@ -138,16 +160,32 @@ impl CloudAnalysis {
             )));
         }
         crate::spatial::knn::check_finite(points)?;
-        let order = morton_order(points);
-        if order.len() != points.len() {
-            return Err(Error::InvalidInput(
-                "analysis: the points have no spatial order (a non-finite coordinate)".into(),
-            ));
+        let Some((order, rank)) = morton_order_unique(points) else {
+            return Err(Error::InvalidInput("analysis: no points".into()));
+        };
+        if order.len() <= params.max_k {
+            return Err(Error::InvalidInput(format!(
+                "{} points, {} of them distinct: the analysis needs at least {} distinct points \
+                 (its neighbourhoods hold {} points)",
+                points.len(),
+                order.len(),
+                params.max_k + 1,
+                params.max_k
+            )));
         }
+        let duplicates = points.len() - order.len();
+        if duplicates > 0 {
+            tracing::info!(
+                "{duplicates} of {} points repeat another exactly: analysed once",
+                points.len()
+            );
+        }
+        let rank = if duplicates > 0 { rank } else { Vec::new() };
         let sorted = order.par_iter().map(|&i| points[i as usize]).collect();
         Ok(CloudAnalysis {
             params,
             order,
+            rank,
             points: sorted,
             neighbours: OnceLock::new(),
             noise: OnceLock::new(),
@@ -200,23 +238,42 @@ impl CloudAnalysis {
         &self.params
     }
 
-    /// The points in Morton order.
+    /// The distinct points in Morton order.
     pub fn points(&self) -> &[Point3] {
         &self.points
     }
 
-    /// `order()[r]` is the input index of sorted point r.
+    /// `order()[r]` is the input index of sorted point r (the first of its duplicates).
     pub fn order(&self) -> &[u32] {
         &self.order
     }
 
-    /// Per-point values in the analysis' (sorted) order, put back into the input order.
-    pub fn to_input_order<T: Copy + Default + Send + Sync>(&self, sorted: &[T]) -> Vec<T> {
-        let mut out = vec![T::default(); sorted.len()];
-        for (r, &i) in self.order.iter().enumerate() {
-            out[i as usize] = sorted[r];
+    /// The number of input points (distinct or not).
+    pub fn input_len(&self) -> usize {
+        if self.rank.is_empty() {
+            self.order.len()
+        } else {
+            self.rank.len()
         }
-        out
+    }
+
+    /// Input points that repeat an earlier one exactly (analysed as that one).
+    pub fn duplicates(&self) -> usize {
+        self.input_len() - self.order.len()
+    }
+
+    /// Per-point values in the analysis' (sorted) order, put back into the input order; each
+    /// duplicate takes its first copy's value.
+    pub fn to_input_order<T: Copy + Default + Send + Sync>(&self, sorted: &[T]) -> Vec<T> {
+        if self.rank.is_empty() {
+            let mut out = vec![T::default(); sorted.len()];
+            for (r, &i) in self.order.iter().enumerate() {
+                out[i as usize] = sorted[r];
+            }
+            out
+        } else {
+            self.rank.par_iter().map(|&r| sorted[r as usize]).collect()
+        }
     }
 
     /// The `max_k` nearest neighbours of every (sorted) point, nearest first.
@@ -239,6 +296,10 @@ impl CloudAnalysis {
     /// consistently oriented PCA normals as the segmentation estimates them
     /// ([`crate::segment::estimated_normals`]).
     pub fn normals(&self) -> Result<&[Point3]> {
+        if let Some(n) = self.normals.get() {
+            return Ok(n);
+        }
+        self.params.check_needed(false, "the normal estimation")?;
         let nbrs = self.neighbours()?;
         once(&self.normals, &self.counters.normals, || {
             estimated_normals(&self.points, nbrs, &self.params.points)
@@ -251,6 +312,8 @@ impl CloudAnalysis {
         if let Some(s) = self.segmentation.get() {
             return Ok(s);
         }
+        self.params
+            .check_needed(self.normals_given, "the segmentation")?;
         let nbrs = self.neighbours()?;
         let normals = self.normals()?;
         once(&self.segmentation, &self.counters.segmentations, || {

@@ -52,6 +52,7 @@ mod thresholds;
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 pub use histogram::{Search, Split, L_START};
@@ -61,6 +62,7 @@ pub use network::{curve_network, CurveNetwork};
 use crate::analysis::CloudAnalysis;
 use crate::geometry::{chain_segments, Point3};
 use crate::lines::{self, FirstOrder, LineNetwork, LinesParams, Smoothing};
+use crate::spatial::distinct_in_input_order;
 use crate::{Error, Result};
 use region::process_region;
 use smooth_regions::{island_owners, Shared};
@@ -354,6 +356,8 @@ fn check_params(params: &FilletParams) -> Result<()> {
 /// Runs the pipeline of the module documentation on `points`; with `with_sharp` the sharp lines
 /// of the same first-order segmentation are returned too (the whole curve network).
 ///
+/// Exact duplicates are processed once (their copies take the original's labels).
+///
 /// Errors: too few points, non-finite coordinates, invalid parameters.
 pub fn extract_fillets(
     points: &[Point3],
@@ -361,8 +365,23 @@ pub fn extract_fillets(
     with_sharp: bool,
 ) -> Result<Fillets> {
     check_params(params)?;
-    let first = lines::first_order(points, &params.lines)?;
-    extract_fillets_with(points, &first, params, with_sharp)
+    let Some((distinct, of)) = distinct_in_input_order(points) else {
+        let first = lines::first_order(points, &params.lines)?;
+        return extract_fillets_with(points, &first, params, with_sharp);
+    };
+    let first = lines::first_order(&distinct, &params.lines)?;
+    let mut f = extract_fillets_with(&distinct, &first, params, with_sharp)?;
+    fn expand<T: Copy + Send + Sync>(of: &[u32], v: &[T]) -> Vec<T> {
+        of.par_iter().map(|&u| v[u as usize]).collect()
+    }
+    f.region = expand(&of, &f.region);
+    f.curvature = expand(&of, &f.curvature);
+    f.label = expand(&of, &f.label);
+    f.patch = expand(&of, &f.patch);
+    if let Some(net) = f.sharp.as_mut() {
+        net.segmentation.labels = expand(&of, &net.segmentation.labels);
+    }
+    Ok(f)
 }
 
 /// [`extract_fillets`] on a shared analysis of the cloud: the first-order structure is built

@@ -44,6 +44,7 @@ pub mod smooth;
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 pub use graph::{CloseReport, ClusterGraph};
@@ -52,7 +53,7 @@ pub use segment::{region_grow, ClusterLabels};
 use crate::analysis::CloudAnalysis;
 use crate::estimate::ring_normals;
 use crate::geometry::{chain_segments, Csr, Point3};
-use crate::spatial::{delaunay_rings, knn, Neighborhoods, RingParams};
+use crate::spatial::{delaunay_rings, distinct_in_input_order, knn, Neighborhoods, RingParams};
 use crate::{Error, Result};
 
 /// Parameters of [`extract_lines`].
@@ -294,12 +295,20 @@ pub fn first_order_with(
     })
 }
 
-/// Runs the pipeline (see the module documentation) on `points`.
+/// Runs the pipeline (see the module documentation) on `points`. Exact duplicates are
+/// processed once (their copies take the original's segmentation label).
 ///
-/// Errors: fewer than k + 1 points, non-finite coordinates, invalid parameters.
+/// Errors: fewer than k + 1 distinct points, non-finite coordinates, invalid parameters.
 pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetwork> {
-    let first = first_order(points, params)?;
-    lines_of(points, &first, params)
+    let Some((distinct, of)) = distinct_in_input_order(points) else {
+        let first = first_order(points, params)?;
+        return lines_of(points, &first, params);
+    };
+    let first = first_order(&distinct, params)?;
+    let mut net = lines_of(&distinct, &first, params)?;
+    let labels = &net.segmentation.labels;
+    net.segmentation.labels = of.par_iter().map(|&u| labels[u as usize]).collect();
+    Ok(net)
 }
 
 /// [`extract_lines`] on a shared analysis of the cloud: the Delaunay 1-rings are built from its

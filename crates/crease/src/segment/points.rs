@@ -70,7 +70,7 @@ use crate::estimate::orient::orient_normals_k;
 use crate::estimate::{pca_normals, PcaParams};
 use crate::geometry::vec3::{dist, dot, normalize};
 use crate::geometry::{Aabb, Csr, Point3};
-use crate::spatial::{knn, morton_order, Adjacency, Neighborhoods};
+use crate::spatial::{knn, morton_order_unique, Adjacency, Neighborhoods};
 use crate::{Error, Result};
 
 use crate::geometry::surface::signed_distance;
@@ -149,31 +149,36 @@ pub fn segment_points(
 ) -> Result<PointSegmentation> {
     // The per-point work (curvature regions, growing) walks the neighbour graph; on a cloud in
     // random order every step is a cache miss. So the cloud is processed in Morton order and
-    // the per-point results are put back into the input order.
+    // the per-point results are put back into the input order. Exact duplicates are segmented
+    // once (zero-length edges would fill their neighbourhoods) and take their first copy's
+    // surface (and area: the area a point stands for is counted on each copy).
     let finite = points.iter().all(|p| p.iter().all(|v| v.is_finite()));
-    let order = if finite && normals.is_none_or(|n| n.len() == points.len()) {
-        morton_order(points)
+    let unique = if finite && normals.is_none_or(|n| n.len() == points.len()) {
+        morton_order_unique(points)
     } else {
-        Vec::new()
+        None
     };
-    if order.len() != points.len() {
+    let Some((order, rank)) = unique else {
         return segment_ordered(points, normals, params, pp);
+    };
+    if order.len() < points.len() {
+        tracing::info!(
+            "{} of {} points repeat another exactly: segmented once",
+            points.len() - order.len(),
+            points.len()
+        );
     }
     let sorted: Vec<Point3> = order.par_iter().map(|&i| points[i as usize]).collect();
     let sorted_normals: Option<Vec<Point3>> =
         normals.map(|n| order.par_iter().map(|&i| n[i as usize]).collect());
     let mut seg = segment_ordered(&sorted, sorted_normals.as_deref(), params, pp)?;
-    fn unsort<T: Copy + Default + Send + Sync>(order: &[u32], v: &[T]) -> Vec<T> {
-        let mut out = vec![T::default(); v.len()];
-        for (r, &i) in order.iter().enumerate() {
-            out[i as usize] = v[r];
-        }
-        out
+    fn unsort<T: Copy + Send + Sync>(rank: &[u32], v: &[T]) -> Vec<T> {
+        rank.par_iter().map(|&r| v[r as usize]).collect()
     }
-    seg.point_surface = unsort(&order, &seg.point_surface);
-    seg.point_labels = unsort(&order, &seg.point_labels);
-    seg.sharp = unsort(&order, &seg.sharp);
-    seg.point_area = unsort(&order, &seg.point_area);
+    seg.point_surface = unsort(&rank, &seg.point_surface);
+    seg.point_labels = unsort(&rank, &seg.point_labels);
+    seg.sharp = unsort(&rank, &seg.sharp);
+    seg.point_area = unsort(&rank, &seg.point_area);
     Ok(seg)
 }
 

@@ -92,12 +92,14 @@ use std::borrow::Cow;
 
 use rayon::prelude::*;
 
-use crate::analysis::CloudAnalysis;
+use crate::analysis::{AnalysisParams, CloudAnalysis};
 use crate::estimate::normals::{mesh_vertex_normals, PcaWeight, Weighting};
 use crate::geometry::{MeshTopology, Point3, TriMesh};
-use crate::segment::{segment_points, PointParams, PointSegmentation, SegmentParams};
+use crate::segment::{
+    neighbours_needed, segment_points, PointParams, PointSegmentation, SegmentParams,
+};
 use crate::spatial::mesh_rings::vertex_k_rings_layered;
-use crate::spatial::{knn, morton_order, Neighborhoods};
+use crate::spatial::{morton_order, Neighborhoods};
 use crate::threshold::{otsu, OtsuParams};
 use crate::{Error, Result};
 
@@ -305,27 +307,33 @@ fn check_scales(scales: &[usize], what: &str) -> Result<()> {
     Ok(())
 }
 
-/// Sharp feature points of a point cloud (see the module documentation): one kNN query at the
-/// largest scale, then [`detect_points_with`].
+/// Sharp feature points of a point cloud (see the module documentation): [`detect`] on a new
+/// analysis of the cloud (Morton order, exact duplicates once, one kNN query at the largest
+/// scale, or at the segmentation's when the surface stage reads more).
 ///
-/// Errors: fewer points than the largest k + 1, non-finite coordinates, invalid parameters.
+/// Errors: fewer distinct points than the largest k + 1, non-finite coordinates, invalid
+/// parameters.
 pub fn detect_points(points: &[Point3], params: &SharpParams) -> Result<SharpResult> {
+    let analysis = CloudAnalysis::new(points, analysis_params(params)?)?;
+    detect(&analysis, params)
+}
+
+/// The settings of the analysis [`detect_points`] builds: neighbour lists as long as the
+/// largest scale, or as the segmentation reads when the surface stage runs.
+pub fn analysis_params(params: &SharpParams) -> Result<AnalysisParams> {
     let scales = params
         .scales
         .clone()
         .unwrap_or_else(|| CLOUD_SCALES.to_vec());
     check_scales(&scales, "neighbourhood sizes")?;
+    let mut ap = AnalysisParams::default();
     let kmax = scales.iter().copied().max().unwrap_or(1);
-    match spatial_order(points) {
-        Some((order, sorted)) => {
-            let nbrs = knn(&sorted, kmax)?;
-            detect_points_with(&sorted, &nbrs, params)?.to_input_order(&order)
-        }
-        None => {
-            let nbrs = knn(points, kmax)?;
-            detect_points_with(points, &nbrs, params)
-        }
-    }
+    ap.max_k = if params.surfaces.is_some() {
+        kmax.max(neighbours_needed(&ap.points, false))
+    } else {
+        kmax
+    };
+    Ok(ap)
 }
 
 /// [`detect_points`] from precomputed k-nearest-neighbour lists (at least the largest scale).
@@ -356,10 +364,12 @@ pub fn detect_points_with(
 pub fn detect(analysis: &CloudAnalysis, params: &SharpParams) -> Result<SharpResult> {
     let nbrs = analysis.neighbours()?;
     let ratio = analysis.noise_ratio()?;
-    detect_core(analysis.points(), nbrs, Some(ratio), params, || {
+    let mut r = detect_core(analysis.points(), nbrs, Some(ratio), params, || {
         analysis.segmentation().map(Cow::Borrowed)
-    })?
-    .to_input_order(analysis.order())
+    })?;
+    r.sharp = analysis.to_input_order(&r.sharp);
+    r.sharpness = analysis.to_input_order(&r.sharpness);
+    Ok(r)
 }
 
 /// The cloud detector on `points` with their neighbour lists; `ratio` the measured noise ratio

@@ -227,6 +227,69 @@ pub fn morton_order(points: &[Point3]) -> Vec<u32> {
         .collect()
 }
 
+/// The Morton order of the distinct points of `points`: exact duplicates (equal coordinates;
+/// `-0.0` equals `0.0`) collapse into the first of them. `order[r]` is the input index of the
+/// first (lowest-index) point at rank `r`, `rank[i]` the rank of input point `i`'s position.
+/// Without duplicates `order` is [`morton_order`]'s, unless two distinct points share a code
+/// (a cell of 2⁻²¹ of the box): those are ranked by coordinates, not index. `None` for no
+/// points; the coordinates must be finite.
+///
+/// Duplicates share a code, so they are found by sorting each run of equal codes by
+/// coordinates (runs are one point long but where the sampling is finer than the cells):
+/// a cloud sampled twice over, or a scanner's repeated returns, costs no extra pass.
+pub fn morton_order_unique(points: &[Point3]) -> Option<(Vec<u32>, Vec<u32>)> {
+    let q = Quantizer::new(points)?;
+    let key = |i: u32| points[i as usize].map(|v| (v + 0.0).to_bits());
+    let mut keys = morton_sorted(points, &q);
+    keys.par_chunk_by_mut(|a, b| a.0 == b.0)
+        .filter(|run| run.len() > 1)
+        .for_each(|run| run.sort_unstable_by_key(|&(_, i)| (key(i), i)));
+    let first: Vec<bool> = (0..keys.len())
+        .into_par_iter()
+        .map(|r| r == 0 || keys[r - 1].0 != keys[r].0 || key(keys[r - 1].1) != key(keys[r].1))
+        .collect();
+    let order: Vec<u32> = keys
+        .par_iter()
+        .zip(&first)
+        .filter(|(_, &f)| f)
+        .map(|(&(_, i), _)| i)
+        .collect();
+    let mut rank = vec![0u32; points.len()];
+    let mut r = 0u32;
+    for (k, (&(_, i), &f)) in keys.iter().zip(&first).enumerate() {
+        if f && k > 0 {
+            r += 1;
+        }
+        rank[i as usize] = r;
+    }
+    Some((order, rank))
+}
+
+/// The distinct points of `points` in input order, when some repeat exactly: the first copy
+/// of each (ascending input index) and, for every input point, the index of its copy among
+/// them ([`morton_order_unique`] finds them). `None` when no point repeats another, or a
+/// coordinate is not finite (the pipelines report that themselves). For the pipelines whose
+/// results depend on the point order: a cloud without duplicates is processed as it was.
+pub fn distinct_in_input_order(points: &[Point3]) -> Option<(Vec<Point3>, Vec<u32>)> {
+    if !points.par_iter().all(|p| p.iter().all(|v| v.is_finite())) {
+        return None;
+    }
+    let (order, rank) = morton_order_unique(points)?;
+    if order.len() == points.len() {
+        return None;
+    }
+    let mut first = order.clone();
+    first.par_sort_unstable();
+    // Position in `first` of each Morton rank's point.
+    let pos: Vec<u32> = order
+        .par_iter()
+        .map(|i| first.partition_point(|f| f < i) as u32)
+        .collect();
+    let of = rank.par_iter().map(|&r| pos[r as usize]).collect();
+    let distinct = first.par_iter().map(|&i| points[i as usize]).collect();
+    Some((distinct, of))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -111,17 +111,27 @@ fn the_analysis_is_identical_whatever_the_thread_count() {
 #[test]
 fn bad_settings_and_too_small_clouds_are_errors() {
     let pts = cloud(0.0);
+    // Lists shorter than the segmentation's 20 neighbours serve a stage that reads 10, and the
+    // segmentation (or the normals) asked for is an error.
     let small = CloudAnalysis::new(
         &pts,
         AnalysisParams {
             max_k: 10,
             ..Default::default()
         },
-    );
-    assert!(
-        small.is_err(),
-        "max_k below the segmentation's 20 neighbours"
-    );
+    )
+    .expect("an analysis for 10 neighbours");
+    let e = small
+        .segmentation()
+        .expect_err("max_k below the segmentation's 20");
+    assert!(e.to_string().contains("20 neighbours"), "{e}");
+    assert!(small.normals().is_err());
+    assert_eq!(small.counts().neighbours, 0, "refused before the query");
+    let zero = AnalysisParams {
+        max_k: 0,
+        ..Default::default()
+    };
+    assert!(CloudAnalysis::new(&pts, zero).is_err());
     let few = CloudAnalysis::new(&pts[..30], AnalysisParams::default());
     assert!(few.is_err(), "30 points for 40 neighbours");
     let mut nan = pts.clone();
@@ -141,4 +151,50 @@ fn bad_settings_and_too_small_clouds_are_errors() {
         detect(&a, &SharpParams::default()).is_err(),
         "k = 40 from 20"
     );
+}
+
+#[test]
+fn exact_duplicates_are_analysed_once_and_labelled_like_their_original() {
+    let pts = cloud(0.0);
+    let n = pts.len();
+    // The copy interleaved, and one of its coordinates a negative zero where the original's is
+    // zero (equal points).
+    let mut twice = Vec::with_capacity(2 * n);
+    for p in &pts {
+        twice.push(*p);
+        twice.push(p.map(|v| if v == 0.0 { -0.0 } else { v }));
+    }
+    let a = CloudAnalysis::new(&twice, AnalysisParams::default()).expect("analysis");
+    assert_eq!(a.points().len(), n);
+    assert_eq!((a.input_len(), a.duplicates()), (2 * n, n));
+    assert!(
+        a.order().iter().all(|&i| i % 2 == 0),
+        "the first copies stand"
+    );
+    let once = detect_points(&pts, &SharpParams::default()).expect("sharp");
+    let both = detect(&a, &SharpParams::default()).expect("sharp");
+    for i in 0..n {
+        assert_eq!(both.sharp[2 * i], once.sharp[i]);
+        assert_eq!(both.sharp[2 * i + 1], once.sharp[i]);
+        assert_eq!(both.sharpness[2 * i + 1], once.sharpness[i]);
+    }
+    let seg_once = segment_points(
+        &pts,
+        None,
+        &SegmentParams::default(),
+        &PointParams::default(),
+    )
+    .expect("segmentation");
+    let seg_both = segment_points(
+        &twice,
+        None,
+        &SegmentParams::default(),
+        &PointParams::default(),
+    )
+    .expect("segmentation");
+    assert_eq!(seg_both.surfaces.len(), seg_once.surfaces.len());
+    for i in 0..n {
+        assert_eq!(seg_both.point_surface[2 * i], seg_once.point_surface[i]);
+        assert_eq!(seg_both.point_surface[2 * i + 1], seg_once.point_surface[i]);
+    }
 }
