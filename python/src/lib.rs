@@ -220,9 +220,18 @@ fn normals<'py>(
     let needs_knn = m != M::Mesh || orient;
     let fused = m == M::Pca && !orient;
     let (normals, t_knn, t_normals, t_orient) = compute(py, move || {
+        // As the CLI: exact duplicates estimated once, each copy given its original's normal.
+        let distinct = if m == M::Mesh {
+            None
+        } else {
+            crease::spatial::distinct_in_input_order(&pos)
+        };
+        let pts = distinct
+            .as_ref()
+            .map_or(pos.as_slice(), |d| d.points.as_slice());
         let t = Instant::now();
         let nbrs = if needs_knn && !fused {
-            Some(crease::spatial::knn(&pos, k)?)
+            Some(crease::spatial::knn(pts, k)?)
         } else {
             None
         };
@@ -231,7 +240,7 @@ fn normals<'py>(
         let mut normals = match (m, &nbrs) {
             (M::Pca, None) => {
                 estimate::normals::pca_normals_direct(
-                    &pos,
+                    pts,
                     &PcaParams {
                         k,
                         ..Default::default()
@@ -241,7 +250,7 @@ fn normals<'py>(
             }
             (M::Pca, Some(nbrs)) => {
                 estimate::pca_normals(
-                    &pos,
+                    pts,
                     nbrs,
                     &PcaParams {
                         k,
@@ -251,12 +260,9 @@ fn normals<'py>(
                 .normals
             }
             (M::Ring, Some(nbrs)) => {
-                let rings = crease::spatial::delaunay_rings(
-                    &pos,
-                    nbrs,
-                    &crease::spatial::RingParams { k },
-                )?;
-                estimate::ring_normals(&pos, &rings)
+                let rings =
+                    crease::spatial::delaunay_rings(pts, nbrs, &crease::spatial::RingParams { k })?;
+                estimate::ring_normals(pts, &rings)
             }
             (M::Ring, None) => {
                 return Err(crease::Error::InvalidArgument(
@@ -272,8 +278,11 @@ fn normals<'py>(
         let t = Instant::now();
         if orient {
             if let Some(nbrs) = &nbrs {
-                normals = estimate::orient_normals(&pos, &normals, nbrs)?;
+                normals = estimate::orient_normals(pts, &normals, nbrs)?;
             }
+        }
+        if let Some(d) = &distinct {
+            normals = d.expand(&normals);
         }
         Ok((normals, t_knn, t_normals, t.elapsed().as_secs_f64()))
     })?;

@@ -93,8 +93,15 @@ pub fn run(g: &Global, a: &CurvatureArgs) -> anyhow::Result<()> {
                     a.k + 1
                 );
             }
+            // Exact duplicates are fitted once (copies would fill the neighbourhoods), and
+            // each copy takes its original's curvature.
+            let distinct = crease::spatial::distinct_in_input_order(&geom.points.positions);
+            let pts = distinct
+                .as_ref()
+                .map_or(geom.points.positions.as_slice(), |d| d.points.as_slice());
             let stage = Stage::start(&format!("{}-nearest neighbours", a.k), g.quiet);
-            let nbrs = crease::spatial::knn(&geom.points.positions, a.k)?;
+            let nbrs = crease::spatial::knn(pts, a.k)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
             stage.finish();
             let stage = Stage::start("quadric curvature", g.quiet);
             let params = QuadricParams { k: a.k };
@@ -105,9 +112,16 @@ pub fn run(g: &Global, a: &CurvatureArgs) -> anyhow::Result<()> {
                         a.input.display()
                     ))
                 })?;
-                quadric_curvature_oriented(&geom.points.positions, &nbrs, normals, &params)?
+                match &distinct {
+                    Some(d) => quadric_curvature_oriented(pts, &nbrs, &d.pick(normals), &params)?,
+                    None => quadric_curvature_oriented(pts, &nbrs, normals, &params)?,
+                }
             } else {
-                quadric_curvature(&geom.points.positions, &nbrs, &params)?
+                quadric_curvature(pts, &nbrs, &params)?
+            };
+            let c = match &distinct {
+                Some(d) => c.select(&d.of),
+                None => c,
             };
             stage.finish();
             summary["method"] = "quadric".into();

@@ -90,10 +90,23 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
     // PCA without --orient needs no stored neighbourhoods: the fused search visits them in
     // spatial order (faster, no n·k lists); its time is reported under "normals".
     let fused = a.method == Method::Pca && !a.orient;
+    // Exact duplicates are estimated once (copies would fill the neighbourhoods, a point
+    // repeated k times having no plane at all), and each copy takes its original's normal.
+    // The cloud methods read the positions (held apart while the mesh method borrows the
+    // geometry as a mesh).
+    let positions = if a.method == Method::Mesh {
+        Vec::new()
+    } else {
+        std::mem::take(&mut geom.points.positions)
+    };
+    let distinct = crease::spatial::distinct_in_input_order(&positions);
+    let pts = distinct
+        .as_ref()
+        .map_or(positions.as_slice(), |d| d.points.as_slice());
     let mut t_knn = 0.0;
     let nbrs = if needs_knn && !fused {
         let stage = Stage::start(&format!("{} nearest neighbours", a.k), g.quiet);
-        let nbrs = crease::spatial::knn(&geom.points.positions, a.k)
+        let nbrs = crease::spatial::knn(pts, a.k)
             .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
         t_knn = stage.finish();
         Some(nbrs)
@@ -104,7 +117,7 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
     let mut normals = match a.method {
         Method::Pca if fused => {
             estimate::normals::pca_normals_direct(
-                &geom.points.positions,
+                pts,
                 &PcaParams {
                     k: a.k,
                     ..Default::default()
@@ -118,7 +131,7 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
                 .as_ref()
                 .ok_or_else(|| anyhow::anyhow!("internal: no neighbourhoods for --method pca"))?;
             estimate::pca_normals(
-                &geom.points.positions,
+                pts,
                 nbrs,
                 &PcaParams {
                     k: a.k,
@@ -131,13 +144,10 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
             let nbrs = nbrs
                 .as_ref()
                 .ok_or_else(|| anyhow::anyhow!("internal: no neighbourhoods for --method ring"))?;
-            let rings = crease::spatial::delaunay_rings(
-                &geom.points.positions,
-                nbrs,
-                &crease::spatial::RingParams { k: a.k },
-            )
-            .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
-            estimate::ring_normals(&geom.points.positions, &rings)
+            let rings =
+                crease::spatial::delaunay_rings(pts, nbrs, &crease::spatial::RingParams { k: a.k })
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+            estimate::ring_normals(pts, &rings)
         }
         Method::Mesh => {
             if !geom.is_mesh() {
@@ -168,9 +178,15 @@ pub fn run(g: &Global, a: &NormalsArgs) -> anyhow::Result<()> {
     if a.orient {
         if let Some(nbrs) = &nbrs {
             let stage = Stage::start("orienting normals", g.quiet);
-            normals = estimate::orient_normals(&geom.points.positions, &normals, nbrs)?;
+            normals = estimate::orient_normals(pts, &normals, nbrs)?;
             t_orient = stage.finish();
         }
+    }
+    if let Some(d) = &distinct {
+        normals = d.expand(&normals);
+    }
+    if a.method != Method::Mesh {
+        geom.points.positions = positions;
     }
     geom.points.set_normals(normals)?;
     let t_write = Instant::now();

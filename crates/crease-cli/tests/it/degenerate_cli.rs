@@ -259,9 +259,9 @@ fn one_huge_face_leaves_the_mesh_edges_as_they_are() {
 #[test]
 fn exact_duplicates_are_analysed_once() {
     // A cube sampled twice over, the copy in reverse order (a scanner's repeated returns): every
-    // copy gets its original's labels, and the lines are those of the cube sampled once (before,
-    // the copies filled the neighbourhoods with zero-length edges: 8 planes instead of 6, 632
-    // sharp points instead of twice 397).
+    // copy gets its original's labels, normal and curvature, and the lines are those of the cube
+    // sampled once (before, the copies filled the neighbourhoods with zero-length edges: 8
+    // planes instead of 6, 632 sharp points instead of twice 397).
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let cube = cube_points(d);
@@ -271,7 +271,13 @@ fn exact_duplicates_are_analysed_once() {
     twice.extend(cube.iter().rev());
     let twice = write_xyz(&d.join("twice.xyz"), &twice);
     for input in [&clean, &twice] {
-        for (cmd, ext) in [("sharp", "ply"), ("segment", "ply"), ("network", "obj")] {
+        for (cmd, ext) in [
+            ("sharp", "ply"),
+            ("segment", "ply"),
+            ("network", "obj"),
+            ("normals", "ply"),
+            ("curvature", "ply"),
+        ] {
             let (code, err) = run(cmd, ext, input);
             assert_eq!(code, 0, "{cmd}: {err}");
         }
@@ -284,6 +290,7 @@ fn exact_duplicates_are_analysed_once() {
         ("sharp", "sharp"),
         ("sharp", "sharpness"),
         ("segment", "surface"),
+        ("curvature", "mean_curvature"),
     ] {
         let once = attribute(&format!("clean-{f}.ply"), name);
         let both = attribute(&format!("twice-{f}.ply"), name);
@@ -291,6 +298,13 @@ fn exact_duplicates_are_analysed_once() {
         let copy: Vec<f64> = both[n..].iter().rev().copied().collect();
         assert_eq!(copy, once, "{name} of the copies");
     }
+    let normals = |f: &str| {
+        let (g, _) = crease::io::read(d.join(f), &Default::default()).unwrap();
+        g.points.normals.unwrap()
+    };
+    let (once, both) = (normals("clean-normals.ply"), normals("twice-normals.ply"));
+    assert_eq!(&both[..n], &once[..]);
+    assert!(both[n..].iter().rev().eq(once.iter()));
     let planes: std::collections::BTreeSet<i64> = attribute("twice-segment.ply", "surface")
         .iter()
         .map(|&s| s as i64)

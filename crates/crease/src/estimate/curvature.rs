@@ -69,6 +69,23 @@ impl Curvature {
         self.k1.is_empty()
     }
 
+    /// The curvatures of the points `picks` (e.g. every input point's distinct copy,
+    /// [`crate::spatial::distinct_in_input_order`]).
+    pub fn select(&self, picks: &[u32]) -> Curvature {
+        fn pick<T: Copy + Send + Sync>(v: &[T], picks: &[u32]) -> Vec<T> {
+            picks.par_iter().map(|&i| v[i as usize]).collect()
+        }
+        Curvature {
+            k1: pick(&self.k1, picks),
+            k2: pick(&self.k2, picks),
+            mean: pick(&self.mean, picks),
+            gaussian: pick(&self.gaussian, picks),
+            dir1: pick(&self.dir1, picks),
+            dir2: pick(&self.dir2, picks),
+            normal: pick(&self.normal, picks),
+        }
+    }
+
     /// Number of points whose fit failed (`NaN` curvatures).
     pub fn num_failed(&self) -> usize {
         self.k1.iter().filter(|k| k.is_nan()).count()

@@ -52,7 +52,6 @@ mod thresholds;
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 
 pub use histogram::{Search, Split, L_START};
@@ -365,21 +364,18 @@ pub fn extract_fillets(
     with_sharp: bool,
 ) -> Result<Fillets> {
     check_params(params)?;
-    let Some((distinct, of)) = distinct_in_input_order(points) else {
+    let Some(distinct) = distinct_in_input_order(points) else {
         let first = lines::first_order(points, &params.lines)?;
         return extract_fillets_with(points, &first, params, with_sharp);
     };
-    let first = lines::first_order(&distinct, &params.lines)?;
-    let mut f = extract_fillets_with(&distinct, &first, params, with_sharp)?;
-    fn expand<T: Copy + Send + Sync>(of: &[u32], v: &[T]) -> Vec<T> {
-        of.par_iter().map(|&u| v[u as usize]).collect()
-    }
-    f.region = expand(&of, &f.region);
-    f.curvature = expand(&of, &f.curvature);
-    f.label = expand(&of, &f.label);
-    f.patch = expand(&of, &f.patch);
+    let first = lines::first_order(&distinct.points, &params.lines)?;
+    let mut f = extract_fillets_with(&distinct.points, &first, params, with_sharp)?;
+    f.region = distinct.expand(&f.region);
+    f.curvature = distinct.expand(&f.curvature);
+    f.label = distinct.expand(&f.label);
+    f.patch = distinct.expand(&f.patch);
     if let Some(net) = f.sharp.as_mut() {
-        net.segmentation.labels = expand(&of, &net.segmentation.labels);
+        net.segmentation.labels = distinct.expand(&net.segmentation.labels);
     }
     Ok(f)
 }

@@ -44,7 +44,6 @@ pub mod smooth;
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 
 pub use graph::{CloseReport, ClusterGraph};
@@ -300,14 +299,13 @@ pub fn first_order_with(
 ///
 /// Errors: fewer than k + 1 distinct points, non-finite coordinates, invalid parameters.
 pub fn extract_lines(points: &[Point3], params: &LinesParams) -> Result<LineNetwork> {
-    let Some((distinct, of)) = distinct_in_input_order(points) else {
+    let Some(distinct) = distinct_in_input_order(points) else {
         let first = first_order(points, params)?;
         return lines_of(points, &first, params);
     };
-    let first = first_order(&distinct, params)?;
-    let mut net = lines_of(&distinct, &first, params)?;
-    let labels = &net.segmentation.labels;
-    net.segmentation.labels = of.par_iter().map(|&u| labels[u as usize]).collect();
+    let first = first_order(&distinct.points, params)?;
+    let mut net = lines_of(&distinct.points, &first, params)?;
+    net.segmentation.labels = distinct.expand(&net.segmentation.labels);
     Ok(net)
 }
 

@@ -179,7 +179,7 @@ fn check_knn_args(points: &[Point3], k: usize) -> Result<()> {
 const EXTENT_RANGE: (f64, f64) = (1e-140, 1e150);
 
 /// Errors when the points span so little (but not nothing) or so much that squared distances
-/// leave f64's normal range ([`EXTENT_RANGE`]).
+/// leave f64's normal range (spans from 1e-140 to 1e150 pass; zero passes too).
 pub fn check_extent(points: &[Point3]) -> Result<()> {
     let (lo, hi) = points
         .par_iter()

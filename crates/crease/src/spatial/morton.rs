@@ -265,12 +265,40 @@ pub fn morton_order_unique(points: &[Point3]) -> Option<(Vec<u32>, Vec<u32>)> {
     Some((order, rank))
 }
 
-/// The distinct points of `points` in input order, when some repeat exactly: the first copy
-/// of each (ascending input index) and, for every input point, the index of its copy among
-/// them ([`morton_order_unique`] finds them). `None` when no point repeats another, or a
+/// The distinct points of a cloud in input order ([`distinct_in_input_order`]).
+#[derive(Debug, Clone)]
+pub struct Distinct {
+    /// Input index of the first copy of each distinct point, ascending.
+    pub first: Vec<u32>,
+    /// The distinct points (`points[first[u]]`).
+    pub points: Vec<Point3>,
+    /// For every input point, the index of its copy among the distinct points.
+    pub of: Vec<u32>,
+}
+
+impl Distinct {
+    /// Per-input values (normals, ...) for the distinct points: their first copies'.
+    pub fn pick<T: Copy + Send + Sync>(&self, per_input: &[T]) -> Vec<T> {
+        self.first
+            .par_iter()
+            .map(|&i| per_input[i as usize])
+            .collect()
+    }
+
+    /// Per-distinct-point results for every input point: each copy takes its original's.
+    pub fn expand<T: Copy + Send + Sync>(&self, per_distinct: &[T]) -> Vec<T> {
+        self.of
+            .par_iter()
+            .map(|&u| per_distinct[u as usize])
+            .collect()
+    }
+}
+
+/// The distinct points of `points` in input order, when some repeat exactly (equal
+/// coordinates, found by [`morton_order_unique`]). `None` when no point repeats another, or a
 /// coordinate is not finite (the pipelines report that themselves). For the pipelines whose
 /// results depend on the point order: a cloud without duplicates is processed as it was.
-pub fn distinct_in_input_order(points: &[Point3]) -> Option<(Vec<Point3>, Vec<u32>)> {
+pub fn distinct_in_input_order(points: &[Point3]) -> Option<Distinct> {
     if !points.par_iter().all(|p| p.iter().all(|v| v.is_finite())) {
         return None;
     }
@@ -286,8 +314,8 @@ pub fn distinct_in_input_order(points: &[Point3]) -> Option<(Vec<Point3>, Vec<u3
         .map(|i| first.partition_point(|f| f < i) as u32)
         .collect();
     let of = rank.par_iter().map(|&r| pos[r as usize]).collect();
-    let distinct = first.par_iter().map(|&i| points[i as usize]).collect();
-    Some((distinct, of))
+    let points = first.par_iter().map(|&i| points[i as usize]).collect();
+    Some(Distinct { first, points, of })
 }
 
 #[cfg(test)]
