@@ -206,7 +206,8 @@ class Curves(_Record):
     Attributes:
         polylines: list of (m, 3) float64 arrays, one per polyline; a closed loop repeats its
             first point at the end.
-        groups: per polyline ``"sharp"`` or ``"smooth"`` (the CLI's OBJ groups of ``network``).
+        groups: per polyline ``"sharp"``, ``"smooth"`` or ``"boundary"`` (the cloud's open
+            border, no feature; the CLI's OBJ groups).
         indices: per polyline, the int64 indices of its points in ``vertices``.
         vertices: (v, 3) float64, every polyline vertex once (the CLI writes these).
         clusters: :func:`lines` only: per input point, its cluster of the first-order
@@ -655,8 +656,8 @@ def network(
     boundary: bool = True,
 ) -> Curves:
     """The whole curve network of a cloud, as ``crease network``: sharp and fillet polylines,
-    ``groups`` saying which (``"sharp"`` / ``"smooth"``, the CLI's OBJ groups), and the
-    per-point labels of :func:`fillets`."""
+    ``groups`` saying which (``"sharp"`` / ``"smooth"`` / ``"boundary"``, the CLI's OBJ
+    groups), and the per-point labels of :func:`fillets`."""
     return _fillets(
         points, True, thresholds, k=k, region_angle=region_angle, spur_length=spur_length,
         curvature_k=curvature_k, smoothing=smoothing, median=median, trim=trim, bins=bins,

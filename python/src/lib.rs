@@ -26,7 +26,7 @@ use crease::estimate::{self, PcaParams, Weighting};
 use crease::fillets::{
     curve_network, extract_fillets, FilletParams, Label, Search, ThresholdCount,
 };
-use crease::geometry::{MeshTopology, PointCloud, TriMesh};
+use crease::geometry::{names, MeshTopology, PointCloud, TriMesh};
 use crease::io::{Geometry, ReadOptions, WriteOptions};
 use crease::lines::{extract_lines, LinesParams};
 use crease::meshfeat::{detect_edges, feature_polylines, EdgeMethod, EdgeParams};
@@ -523,7 +523,13 @@ fn lines<'py>(
     let (lines, idx) = polylines(py, &net.vertices, &net.polylines)?;
     d.set_item("polylines", lines)?;
     d.set_item("indices", idx)?;
-    d.set_item("groups", vec!["sharp"; net.polylines.len()])?;
+    d.set_item(
+        "groups",
+        net.boundary_lines
+            .iter()
+            .map(|&b| if b { names::BOUNDARY } else { names::SHARP })
+            .collect::<Vec<_>>(),
+    )?;
     d.set_item("clusters", vec_array(py, net.segmentation.labels.clone()))?;
     let s = serde_json::json!({
         "clusters": net.segmentation.num_clusters(),
@@ -633,17 +639,11 @@ fn fillets<'py>(
         let (lines, idx) = polylines(py, &net.vertices, &net.polylines)?;
         d.set_item("polylines", lines)?;
         d.set_item("indices", idx)?;
-        d.set_item(
-            "groups",
-            net.smooth
-                .iter()
-                .map(|&s| if s { "smooth" } else { "sharp" })
-                .collect::<Vec<_>>(),
-        )?;
-        let sharp_lines = net.smooth.iter().filter(|&&s| !s).count();
+        d.set_item("groups", net.groups())?;
         summary["network"] = serde_json::json!({
-            "sharp_polylines": sharp_lines,
-            "smooth_polylines": net.polylines.len() - sharp_lines,
+            "sharp_polylines": net.count(names::SHARP),
+            "smooth_polylines": net.count(names::SMOOTH),
+            "boundary_polylines": net.count(names::BOUNDARY),
             "joined_smooth_ends": net.joined_ends,
             "open_smooth_ends": net.open_ends,
         });

@@ -165,11 +165,7 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
         network.vertices.clone(),
     ));
     network_geom.polylines = network.polylines.clone();
-    network_geom.polyline_groups = network
-        .smooth
-        .iter()
-        .map(|&s| if s { "smooth" } else { "sharp" }.to_string())
-        .collect();
+    network_geom.polyline_groups = network.groups().iter().map(|g| g.to_string()).collect();
     super::save(g, &dir.join("part-network.obj"), &network_geom, false, &[])?;
     let smooth_lines = network.smooth.iter().filter(|&&s| s).count();
 

@@ -10,7 +10,7 @@ use clap::Args;
 use crease::fillets::{
     curve_network, extract_fillets, FilletParams, Fillets, Label, Search, ThresholdCount,
 };
-use crease::geometry::{Attribute, PointCloud};
+use crease::geometry::{names, Attribute, PointCloud};
 use crease::io::Geometry;
 use crease::lines::LinesParams;
 
@@ -186,15 +186,11 @@ pub fn run(g: &Global, a: &FilletsArgs, network: bool) -> anyhow::Result<()> {
         cloud.set_attribute(Attribute::flag("smooth", smooth_vertex))?;
         out = Geometry::from_cloud(cloud);
         out.polylines = net.polylines.clone();
-        out.polyline_groups = net
-            .smooth
-            .iter()
-            .map(|&s| if s { "smooth" } else { "sharp" }.to_string())
-            .collect();
-        let sharp_lines = net.smooth.iter().filter(|&&s| !s).count();
+        out.polyline_groups = net.groups().iter().map(|g| g.to_string()).collect();
         summary_lines = serde_json::json!({
-            "sharp_polylines": sharp_lines,
-            "smooth_polylines": net.polylines.len() - sharp_lines,
+            "sharp_polylines": net.count(names::SHARP),
+            "smooth_polylines": net.count(names::SMOOTH),
+            "boundary_polylines": net.count(names::BOUNDARY),
             "joined_smooth_ends": net.joined_ends,
             "open_smooth_ends": net.open_ends,
         });

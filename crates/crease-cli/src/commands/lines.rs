@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use crease::geometry::{Attribute, PointCloud};
+use crease::geometry::{names, Attribute, PointCloud};
 use crease::io::Geometry;
 use crease::lines::{extract_lines, LinesParams};
 
@@ -103,6 +103,12 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
     let seconds = start.elapsed().as_secs_f64();
     let mut out = Geometry::from_cloud(PointCloud::from_positions(net.vertices.clone()));
     out.polylines = net.polylines.clone();
+    // OBJ groups: the feature lines, and the cloud's open border apart.
+    out.polyline_groups = net
+        .boundary_lines
+        .iter()
+        .map(|&b| if b { names::BOUNDARY } else { names::SHARP }.to_string())
+        .collect();
     super::save(g, &a.output, &out, a.ascii, &[&a.input])?;
     if let Some(path) = &a.segmentation {
         let mut cloud = geom.points.clone();
@@ -123,6 +129,7 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
             "close": net.close,
             "n": net.n, "d": net.d,
             "polylines": net.polylines.len(),
+            "boundary_polylines": net.boundary_lines.iter().filter(|&&b| b).count(),
             "closed_loops": net.closed_loops(),
             "junctions": net.junctions(),
             "endpoints": net.endpoints(),

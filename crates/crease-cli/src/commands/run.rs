@@ -53,6 +53,8 @@ pub struct RunArgs {
 const SHARP_COLOR: [u8; 3] = [220, 30, 30];
 /// The colour of smooth (fillet) lines in the picture.
 const SMOOTH_COLOR: [u8; 3] = [30, 90, 220];
+/// The cloud's open border in the picture: dark grey (no feature).
+const BOUNDARY_COLOR: [u8; 3] = [90, 90, 90];
 
 pub fn run(g: &Global, a: &RunArgs) -> anyhow::Result<()> {
     // The folder is made (or found unwritable) before any computation.
@@ -154,11 +156,7 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
 
     let mut net = Geometry::from_cloud(PointCloud::from_positions(network.vertices.clone()));
     net.polylines = network.polylines.clone();
-    net.polyline_groups = network
-        .smooth
-        .iter()
-        .map(|&s| if s { names::SMOOTH } else { names::SHARP }.to_string())
-        .collect();
+    net.polyline_groups = network.groups().iter().map(|g| g.to_string()).collect();
     super::save(g, &a.output.join("network.obj"), &net, false, &[&a.input])?;
     write_surfaces(&a.output, &seg.surfaces, &seg.groups, seg.mean_edge)?;
 
@@ -168,14 +166,14 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     let brep = write_brep(a, &name, points, reconstruct_cloud(&analysis))?;
     timed("brep", s);
 
-    let sharp_lines = network.smooth.iter().filter(|&&s| !s).count();
-    let smooth_lines = network.polylines.len() - sharp_lines;
+    let sharp_lines = network.count(names::SHARP);
+    let smooth_lines = network.count(names::SMOOTH);
     if !a.no_picture {
         let lines = network
             .polylines
             .iter()
-            .zip(&network.smooth)
-            .map(|(l, &smooth)| picture_line(l, &network.vertices, smooth))
+            .zip(network.groups())
+            .map(|(l, group)| picture_line(l, &network.vertices, group))
             .collect();
         picture(a, &labels, None, lines, seg.surfaces.len())?;
     }
@@ -190,6 +188,7 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
         "assigned_points": assigned,
         "sharp_polylines": sharp_lines,
         "smooth_polylines": smooth_lines,
+        "boundary_polylines": network.count(names::BOUNDARY),
         "joined_smooth_ends": network.joined_ends,
         "open_smooth_ends": network.open_ends,
         "analysis": analysis.counts(),
@@ -293,7 +292,7 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
     if !a.no_picture {
         let drawn = lines
             .iter()
-            .map(|l| picture_line(l, &out.points.positions, false))
+            .map(|l| picture_line(l, &out.points.positions, names::SHARP))
             .collect();
         let mesh = out.clone().into_mesh().context("labelled mesh")?;
         picture(a, &out, Some(&mesh), drawn, seg.surfaces.len())?;
@@ -338,14 +337,21 @@ fn write_json(path: &Path, value: &serde_json::Value) -> anyhow::Result<()> {
     crate::ui::write_text(path, &(serde_json::to_string_pretty(value)? + "\n"))
 }
 
-fn picture_line(ids: &[u32], vertices: &[[f64; 3]], smooth: bool) -> Polyline {
+/// A polyline of the network in the picture, coloured by its group ([`names::SHARP`],
+/// [`names::SMOOTH`], [`names::BOUNDARY`]).
+fn picture_line(ids: &[u32], vertices: &[[f64; 3]], group: &str) -> Polyline {
     let closed = ids.len() > 2 && ids.first() == ids.last();
     let ids = if closed { &ids[..ids.len() - 1] } else { ids };
+    let (color, label) = match group {
+        names::SMOOTH => (SMOOTH_COLOR, "fillet line"),
+        names::BOUNDARY => (BOUNDARY_COLOR, "open border"),
+        _ => (SHARP_COLOR, "sharp line"),
+    };
     Polyline {
         points: ids.iter().map(|&v| vertices[v as usize]).collect(),
         closed,
-        color: if smooth { SMOOTH_COLOR } else { SHARP_COLOR },
-        label: Some(if smooth { "fillet line" } else { "sharp line" }.to_string()),
+        color,
+        label: Some(label.to_string()),
     }
 }
 

@@ -318,7 +318,15 @@ pub(crate) fn interpolate(points: &[Point3]) -> Curve {
         knots.push(u[j..j + p].iter().sum::<f64>() / p as f64);
     }
     knots.extend(std::iter::repeat_n(1.0, p + 1));
-    let a = nalgebra::DMatrix::from_fn(n, n, |k, i| basis(&knots, p, i, u[k]));
+    // Each row holds the p + 1 basis functions that are nonzero at u[k].
+    let mut a = nalgebra::DMatrix::zeros(n, n);
+    for (k, &t) in u.iter().enumerate() {
+        let s = span(&knots, p, n, t);
+        let nz = basis_funs(&knots, p, s, t);
+        for (j, &b) in nz[..=p].iter().enumerate() {
+            a[(k, s - p + j)] = b;
+        }
+    }
     let Some(lu) = Some(a.lu()) else {
         return Curve::polyline(q);
     };
@@ -355,63 +363,88 @@ pub(crate) fn interpolate(points: &[Point3]) -> Curve {
     }
 }
 
-/// The B-spline basis function N_{i,p}(t) on `knots` (Cox–de Boor; the last basis function is
-/// 1 at the end of the domain).
-fn basis(knots: &[f64], p: usize, i: usize, t: f64) -> f64 {
-    let m = knots.len() - 1;
-    if t >= knots[m] {
-        return if i == m - p - 1 { 1.0 } else { 0.0 };
+/// Largest degree of the splines built here (cubic).
+const MAX_DEGREE: usize = 3;
+
+/// The knot span of `t` on a clamped knot vector `full` of `n` control points and degree `p`:
+/// the s in p..n with full[s] ≤ t < full[s + 1]; the last span at the end of the domain.
+fn span(full: &[f64], p: usize, n: usize, t: f64) -> usize {
+    if t >= full[n] {
+        return n - 1;
     }
-    let mut n: Vec<f64> = (0..=p)
-        .map(|j| {
-            if knots[i + j] <= t && t < knots[i + j + 1] {
-                1.0
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    for d in 1..=p {
-        for j in 0..=p - d {
-            let (a0, a1) = (knots[i + j], knots[i + j + d]);
-            let left = if a1 > a0 {
-                (t - a0) / (a1 - a0) * n[j]
-            } else {
-                0.0
-            };
-            let (b0, b1) = (knots[i + j + 1], knots[i + j + d + 1]);
-            let right = if b1 > b0 {
-                (b1 - t) / (b1 - b0) * n[j + 1]
-            } else {
-                0.0
-            };
-            n[j] = left + right;
-        }
-    }
-    n[0]
+    let s = full[..=n].partition_point(|&k| k <= t);
+    s.saturating_sub(1).clamp(p, n - 1)
 }
 
-/// The point of a clamped B-spline at parameter `t` (de Boor by the basis functions).
-pub(crate) fn bspline_point(
+/// The p + 1 basis functions N_{s-p..=s, p}(t) that are nonzero on span `s` (The NURBS Book,
+/// algorithm A2.2: O(p²), no allocation; 0/0 taken as 0 on repeated knots). Evaluating every
+/// basis function by Cox–de Boor made a long border's spline cost 16 s.
+fn basis_funs(full: &[f64], p: usize, s: usize, t: f64) -> [f64; MAX_DEGREE + 1] {
+    let mut n = [0.0; MAX_DEGREE + 1];
+    let (mut left, mut right) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+    n[0] = 1.0;
+    for j in 1..=p {
+        left[j] = t - full[s + 1 - j];
+        right[j] = full[s + j] - t;
+        let mut saved = 0.0;
+        for r in 0..j {
+            let den = right[r + 1] + left[j - r];
+            let temp = if den != 0.0 { n[r] / den } else { 0.0 };
+            n[r] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        n[j] = saved;
+    }
+    n
+}
+
+/// Points of a clamped B-spline (distinct `knots` with their `multiplicities`) at the
+/// parameters `ts`.
+pub(crate) fn bspline_points(
+    degree: usize,
+    control: &[Point3],
+    knots: &[f64],
+    multiplicities: &[usize],
+    ts: impl IntoIterator<Item = f64>,
+) -> Vec<Point3> {
+    let full: Vec<f64> = knots
+        .iter()
+        .zip(multiplicities)
+        .flat_map(|(&k, &m)| std::iter::repeat_n(k, m))
+        .collect();
+    let (p, n) = (degree.min(MAX_DEGREE), control.len());
+    if n == 0 || full.len() < n + p + 1 {
+        return Vec::new();
+    }
+    ts.into_iter()
+        .map(|t| {
+            let s = span(&full, p, n, t);
+            let b = basis_funs(&full, p, s, t);
+            let mut q = [0.0; 3];
+            for (j, &w) in b[..=p].iter().enumerate() {
+                let c = control[s - p + j];
+                for k in 0..3 {
+                    q[k] += w * c[k];
+                }
+            }
+            q
+        })
+        .collect()
+}
+
+/// The point of a clamped B-spline at parameter `t` ([`bspline_points`]).
+#[cfg(test)]
+fn bspline_point(
     degree: usize,
     control: &[Point3],
     knots: &[f64],
     multiplicities: &[usize],
     t: f64,
 ) -> Point3 {
-    let full: Vec<f64> = knots
-        .iter()
-        .zip(multiplicities)
-        .flat_map(|(&k, &m)| std::iter::repeat_n(k, m))
-        .collect();
-    let mut p = [0.0; 3];
-    for (i, c) in control.iter().enumerate() {
-        let b = basis(&full, degree, i, t);
-        for k in 0..3 {
-            p[k] += b * c[k];
-        }
-    }
-    p
+    bspline_points(degree, control, knots, multiplicities, [t])
+        .first()
+        .copied()
+        .unwrap_or([f64::NAN; 3])
 }
 
 #[cfg(test)]

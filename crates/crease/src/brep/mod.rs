@@ -160,12 +160,8 @@ impl Curve {
             } => {
                 let (a, b) = (knots[0], knots[knots.len() - 1]);
                 let m = 16 * control_points.len();
-                (0..=m)
-                    .map(|i| {
-                        let t = a + (b - a) * i as f64 / m as f64;
-                        intersect::bspline_point(*degree, control_points, knots, multiplicities, t)
-                    })
-                    .collect()
+                let ts = (0..=m).map(|i| a + (b - a) * i as f64 / m as f64);
+                intersect::bspline_points(*degree, control_points, knots, multiplicities, ts)
             }
             _ => Vec::new(),
         }

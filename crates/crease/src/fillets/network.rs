@@ -1,9 +1,10 @@
 //! The whole curve network: the sharp and the smooth lines merged into one vertex set.
 
 use super::Fillets;
-use crate::geometry::Point3;
+use crate::geometry::{names, Point3};
 
-/// The whole curve network: sharp and smooth lines in one vertex set, each polyline tagged.
+/// The whole curve network: sharp and smooth lines (and the cloud's open border) in one vertex
+/// set, each polyline tagged.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct CurveNetwork {
     /// Vertex positions (the sharp network's first).
@@ -12,10 +13,34 @@ pub struct CurveNetwork {
     pub polylines: Vec<Vec<u32>>,
     /// Per polyline: true for a smooth (fillet) line, false for a sharp one.
     pub smooth: Vec<bool>,
+    /// Per polyline: true for the cloud's open border (the sharp network's
+    /// [`crate::lines::LineNetwork::boundary_lines`]), which is no feature line.
+    pub boundary: Vec<bool>,
     /// Smooth-line ends joined to the sharp line they meet.
     pub joined_ends: usize,
     /// Smooth-line ends left open.
     pub open_ends: usize,
+}
+
+impl CurveNetwork {
+    /// Per polyline, its group: [`names::SHARP`], [`names::SMOOTH`] or [`names::BOUNDARY`]
+    /// (the OBJ `g` the CLI writes).
+    pub fn groups(&self) -> Vec<&'static str> {
+        self.smooth
+            .iter()
+            .zip(&self.boundary)
+            .map(|(&smooth, &border)| match (smooth, border) {
+                (true, _) => names::SMOOTH,
+                (false, true) => names::BOUNDARY,
+                (false, false) => names::SHARP,
+            })
+            .collect()
+    }
+
+    /// Polylines in the group `name` ([`CurveNetwork::groups`]).
+    pub fn count(&self, name: &str) -> usize {
+        self.groups().iter().filter(|&&g| g == name).count()
+    }
 }
 
 /// Merges the sharp and the smooth lines of `f` into one network. A smooth line that ends on
@@ -30,6 +55,7 @@ pub fn curve_network(f: &Fillets) -> CurveNetwork {
         net.polylines.extend(sharp.polylines.iter().cloned());
         net.smooth
             .extend(std::iter::repeat_n(false, sharp.polylines.len()));
+        net.boundary.extend_from_slice(&sharp.boundary_lines);
     }
     let base = net.vertices.len() as u32;
     let l = &f.lines;
@@ -83,6 +109,7 @@ pub fn curve_network(f: &Fillets) -> CurveNetwork {
         }
         net.polylines.push(out);
         net.smooth.push(true);
+        net.boundary.push(false);
     }
     net
 }

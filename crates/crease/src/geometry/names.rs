@@ -30,6 +30,9 @@ pub const K2: &str = "k2";
 pub const GAUSSIAN_CURVATURE: &str = "gaussian_curvature";
 /// On a smooth (fillet) line rather than a sharp one (U8 0 / 1), per network vertex.
 pub const SMOOTH: &str = "smooth";
+/// The polyline groups of a curve network (OBJ `g`): sharp lines ([`SHARP`]), smooth (fillet)
+/// lines ([`SMOOTH`]) and the cloud's open border.
+pub const BOUNDARY: &str = "boundary";
 
 /// Ground truth, as the synthetic parts ([`crate::synth`]) write it.
 pub mod gt {

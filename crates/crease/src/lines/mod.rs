@@ -121,6 +121,9 @@ pub struct LineNetwork {
     /// The edges chained into polylines split at junctions; a closed loop repeats its first
     /// vertex at the end.
     pub polylines: Vec<Vec<u32>>,
+    /// Per polyline: true when it runs along the cloud's open border (between boundary
+    /// points) rather than along a feature.
+    pub boundary_lines: Vec<bool>,
     /// The first-order segmentation (per-point cluster labels).
     pub segmentation: ClusterLabels,
     /// Small / large split of the clusters.
@@ -431,7 +434,17 @@ pub fn network(
         .into_iter()
         .map(|[a, b]| [index[a as usize], index[b as usize]])
         .collect();
-    let polylines = chain_segments(vertices.len(), &edges);
+    // An open scan's border is not a feature line: the edges between two boundary points chain
+    // into polylines of their own (`boundary_lines`), never into a sharp line (a sharp line
+    // that meets the border ends there, on a vertex both share).
+    let (border, feature): (Vec<[u32; 2]>, Vec<[u32; 2]>) = edges
+        .iter()
+        .partition(|&&[a, b]| on_boundary[a as usize] && on_boundary[b as usize]);
+    let mut polylines = chain_segments(vertices.len(), &feature);
+    let border_lines = chain_segments(vertices.len(), &border);
+    let mut boundary_lines = vec![false; polylines.len()];
+    boundary_lines.resize(polylines.len() + border_lines.len(), true);
+    polylines.extend(border_lines);
     let t = Instant::now();
     let unsmoothed = vertices.clone();
     let vertices = match smoothing {
@@ -459,6 +472,7 @@ pub fn network(
         boundary_points,
         edges,
         polylines,
+        boundary_lines,
         segmentation: seg,
         small_clusters,
         stages,
