@@ -434,12 +434,30 @@ pub fn network(
         .into_iter()
         .map(|[a, b]| [index[a as usize], index[b as usize]])
         .collect();
-    // An open scan's border is not a feature line: the edges between two boundary points chain
+    // An open scan's border is not a feature line: the edges between two border vertices chain
     // into polylines of their own (`boundary_lines`), never into a sharp line (a sharp line
-    // that meets the border ends there, on a vertex both share).
+    // that meets the border ends there, on a vertex both share). Border vertices: the
+    // boundary points, and the small clusters made mostly of boundary points (the one-sided
+    // neighbourhoods along a border look like a feature to the first-order segmentation).
+    let mut on_border = on_boundary.clone();
+    if let Some(flags) = boundary {
+        let mut share = vec![0u32; seg.sizes.len()];
+        for (&l, &b) in seg.labels.iter().zip(flags) {
+            if b {
+                if let Some(c) = share.get_mut(l as usize) {
+                    *c += 1;
+                }
+            }
+        }
+        for (border, &c) in on_border.iter_mut().zip(&vertex_clusters) {
+            if let (Some(&k), Some(&size)) = (share.get(c as usize), seg.sizes.get(c as usize)) {
+                *border |= 2 * k >= size && size > 0;
+            }
+        }
+    }
     let (border, feature): (Vec<[u32; 2]>, Vec<[u32; 2]>) = edges
         .iter()
-        .partition(|&&[a, b]| on_boundary[a as usize] && on_boundary[b as usize]);
+        .partition(|&&[a, b]| on_border[a as usize] && on_border[b as usize]);
     let mut polylines = chain_segments(vertices.len(), &feature);
     let border_lines = chain_segments(vertices.len(), &border);
     let mut boundary_lines = vec![false; polylines.len()];
