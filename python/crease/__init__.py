@@ -39,6 +39,7 @@ __all__ = [
     "FileFormatError",
     "Geometry",
     "SharpResult",
+    "CurvatureResult",
     "Segmentation",
     "Curves",
     "EdgeResult",
@@ -46,6 +47,7 @@ __all__ = [
     "read",
     "write",
     "normals",
+    "curvature",
     "sharp",
     "segment",
     "lines",
@@ -164,6 +166,19 @@ class SharpResult(_Record):
         "seconds",
         "timings",
     )
+
+
+class CurvatureResult(_Record):
+    """Principal curvatures per point (:func:`curvature`), in the input's order.
+
+    Attributes:
+        k1, k2: (n,) float64, the principal curvatures (k2 <= k1); NaN where no fit exists.
+        mean_curvature, gaussian_curvature: (n,) float64.
+        sharp: the Bézier method's sharp vertices ((n,) bool), or None.
+        failed: the number of points without an estimate.
+    """
+
+    _fields = ("k1", "k2", "mean_curvature", "gaussian_curvature", "sharp", "failed")
 
 
 class Segmentation(_Record):
@@ -493,6 +508,34 @@ def normals(
     """
     p, f, _ = _shape(points, faces)
     return _crease.normals(p, k=int(k), method=method, orient=bool(orient), faces=f, weighting=weighting)["normals"]
+
+
+def curvature(
+    points: Any,
+    k: int = 20,
+    method: str = "quadric",
+    use_normals: bool = False,
+    normals: Any = None,
+    faces: Any = None,
+    sharp_threshold: Optional[float] = None,
+) -> CurvatureResult:
+    """Principal curvatures, as ``crease curvature``.
+
+    ``method``: ``"quadric"`` (a quadric fitted in the local PCA frame of the k nearest
+    neighbours, the default; exact duplicates fitted once) or ``"bezier"`` (the two-pass Bézier
+    fit of Mizoguchi et al. on a mesh's vertices, with sharp vertices above ``sharp_threshold``
+    times the mean edge length). ``use_normals``: orient the quadric by the normals (``normals``,
+    or the input object's), giving signed curvatures, as ``--use-normals``; without it each
+    point's mean curvature is made >= 0.
+    """
+    p, f, n = _shape(points, faces, normals)
+    if use_normals and n is None:
+        raise ValueError("use_normals given but the input has no normals")
+    d = _crease.curvature(
+        p, k=int(k), method=method, normals=n if use_normals else None, faces=f,
+        sharp_threshold=sharp_threshold,
+    )
+    return CurvatureResult(**d)
 
 
 def sharp(

@@ -27,6 +27,14 @@ def normals(
     faces: Optional[npt.NDArray[np.int64]] = ...,
     weighting: str = ...,
 ) -> Dict[str, Any]: ...
+def curvature(
+    points: npt.NDArray[np.float64],
+    k: int = ...,
+    method: str = ...,
+    normals: Optional[npt.NDArray[np.float64]] = ...,
+    faces: Optional[npt.NDArray[np.int64]] = ...,
+    sharp_threshold: Optional[float] = ...,
+) -> Dict[str, Any]: ...
 def sharp(
     points: npt.NDArray[np.float64],
     faces: Optional[npt.NDArray[np.int64]] = ...,

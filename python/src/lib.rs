@@ -22,6 +22,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crease::analysis::{AnalysisParams, CloudAnalysis};
+use crease::estimate::bezier::{bezier_curvature, BezierParams};
+use crease::estimate::curvature::{quadric_curvature_of, QuadricParams};
 use crease::estimate::{self, PcaParams, Weighting};
 use crease::fillets::{
     curve_network, extract_fillets, FilletParams, Label, Search, ThresholdCount,
@@ -293,6 +295,79 @@ fn normals<'py>(
     t.set_item("normals", t_normals)?;
     t.set_item("orient", t_orient)?;
     d.set_item("timings", t)?;
+    Ok(d)
+}
+
+/// `crease curvature`: principal curvatures per point by the quadric fit over the k nearest
+/// neighbours (oriented by `normals` when given), or per mesh vertex by the two-pass Bézier fit
+/// (`method = "bezier"`, with its sharp vertices).
+#[pyfunction]
+#[pyo3(signature = (points, k = 20, method = "quadric", normals = None, faces = None, sharp_threshold = None))]
+fn curvature<'py>(
+    py: Python<'py>,
+    points: Points<'py>,
+    k: usize,
+    method: &str,
+    normals: Option<Points<'py>>,
+    faces: Option<Faces<'py>>,
+    sharp_threshold: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let bezier = match method {
+        "quadric" => false,
+        "bezier" => true,
+        _ => {
+            return Err(value_error(format!(
+                "method must be one of quadric, bezier; got {method:?}"
+            )))
+        }
+    };
+    if !bezier && k < 5 {
+        return Err(value_error(format!(
+            "k must be at least 5 for the quadric fit, got {k}"
+        )));
+    }
+    let mut bp = BezierParams::default();
+    if let Some(t) = sharp_threshold {
+        if !(t > 0.0 && t.is_finite()) {
+            return Err(value_error(format!(
+                "sharp_threshold must be a positive number, got {t}"
+            )));
+        }
+        bp.sharp_threshold = t;
+    }
+    let (pos, faces) = shape_input(&points, faces.as_ref())?;
+    let given = opt_points("normals", normals.as_ref())?;
+    if bezier && faces.as_ref().is_none_or(|f| f.is_empty()) {
+        return Err(value_error(
+            "the Bézier method needs a triangle mesh (faces), and none were given (use method \
+             'quadric' for point clouds)",
+        ));
+    }
+    if !bezier && pos.len() < k + 1 {
+        return Err(value_error(format!(
+            "{} points, the quadric fit with k = {k} needs at least {}",
+            pos.len(),
+            k + 1
+        )));
+    }
+    let (c, sharp) = compute(py, move || {
+        if bezier {
+            let mesh = TriMesh::new(pos, faces.unwrap_or_default())?;
+            let topo = MeshTopology::new(&mesh)?;
+            let b = bezier_curvature(&mesh, &topo, &bp)?;
+            Ok((b.curvature, Some(b.sharp)))
+        } else {
+            let c = quadric_curvature_of(&pos, given.as_deref(), &QuadricParams { k })?;
+            Ok((c, None))
+        }
+    })?;
+    let d = PyDict::new(py);
+    d.set_item("failed", c.num_failed())?;
+    d.set_item("k1", vec_array(py, c.k1))?;
+    d.set_item("k2", vec_array(py, c.k2))?;
+    d.set_item("mean_curvature", vec_array(py, c.mean))?;
+    d.set_item("gaussian_curvature", vec_array(py, c.gaussian))?;
+    d.set_item("sharp", sharp.map(|s| vec_array(py, s)))?;
     Ok(d)
 }
 
@@ -942,6 +1017,7 @@ fn _crease(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(write, m)?)?;
     m.add_function(wrap_pyfunction!(normals, m)?)?;
+    m.add_function(wrap_pyfunction!(curvature, m)?)?;
     m.add_function(wrap_pyfunction!(sharp, m)?)?;
     m.add_function(wrap_pyfunction!(segment, m)?)?;
     m.add_function(wrap_pyfunction!(lines, m)?)?;

@@ -238,3 +238,54 @@ def test_reconstruct_cloud_equal_cli(data, cube, cli, tmp_path):
     r = crease.reconstruct(cube, out=tmp_path / "cube.step")  # name from out's stem: "cube"
     assert r.step == (tmp_path / "c.step").read_text()
     assert r.solid == summary["solid"] and r.faces == summary["faces"]
+
+
+# --- curvature ---------------------------------------------------------------------------------
+
+
+def _same_as_ply(values, column):
+    """The module's float64 values rounded as the CLI's PLY column stores them."""
+    return np.array_equal(values.astype(column.dtype), column, equal_nan=True)
+
+
+@pytest.mark.parametrize("extra", [[], ["-k", "12"], ["--use-normals"]])
+def test_curvature_equal_cli(data, cube, cli, tmp_path, extra):
+    cli("curvature", data / "cube.ply", "-o", tmp_path / "c.ply", "--ascii", *extra)
+    v = read_ascii_ply(tmp_path / "c.ply")["vertex"]
+    kw = {}
+    if "-k" in extra:
+        kw["k"] = 12
+    if "--use-normals" in extra:
+        kw["use_normals"] = True
+    c = crease.curvature(cube, **kw)
+    assert c.k1.dtype == np.float64 and c.k1.shape == (5000,) and c.sharp is None
+    for name in ("k1", "k2", "mean_curvature", "gaussian_curvature"):
+        assert _same_as_ply(c[name], v[name]), name
+
+
+def test_curvature_bezier_equal_cli(data, cube_mesh, cli, tmp_path):
+    cli("curvature", data / "cube_mesh.ply", "-o", tmp_path / "b.ply", "--ascii", "--method", "bezier")
+    v = read_ascii_ply(tmp_path / "b.ply")["vertex"]
+    c = crease.curvature(cube_mesh.points, method="bezier", faces=cube_mesh.faces)
+    assert _same_as_ply(c.mean_curvature, v["mean_curvature"])
+    assert np.array_equal(c.sharp, v["sharp"].astype(bool))
+    assert c.sharp.any()  # the cube's edges
+
+
+def test_curvature_of_a_sphere_and_of_repeated_points():
+    """Analytic: points on a sphere of radius 2 have principal curvatures 1/2; a cloud whose
+    points each appear twice gets the same answer on both copies."""
+    rng = np.random.default_rng(5)
+    v = rng.normal(size=(4000, 3))
+    p = 2.0 * v / np.linalg.norm(v, axis=1, keepdims=True)
+    c = crease.curvature(p)
+    assert c.failed == 0
+    assert np.allclose(c.k1, 0.5, atol=0.01) and np.allclose(c.k2, 0.5, atol=0.01)
+    signed = crease.curvature(p, use_normals=True, normals=p / 2.0)  # outward normals
+    assert np.allclose(signed.mean_curvature, 0.5, atol=0.01)
+    twice = crease.curvature(np.concatenate([p, p[::-1]]))
+    assert np.array_equal(twice.k1[:4000], c.k1) and np.array_equal(twice.k1[4000:], c.k1[::-1])
+    with pytest.raises(ValueError, match="no normals"):
+        crease.curvature(p, use_normals=True)
+    with pytest.raises(ValueError, match="at least 5"):
+        crease.curvature(p, k=3)

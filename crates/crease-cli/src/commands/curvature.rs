@@ -9,9 +9,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use crease::estimate::bezier::{bezier_curvature, BezierParams};
-use crease::estimate::curvature::{
-    quadric_curvature, quadric_curvature_oriented, Curvature, QuadricParams,
-};
+use crease::estimate::curvature::{quadric_curvature_of, Curvature, QuadricParams};
 use crease::geometry::{Attribute, MeshTopology, TriMesh};
 
 use crate::args::Global;
@@ -93,36 +91,22 @@ pub fn run(g: &Global, a: &CurvatureArgs) -> anyhow::Result<()> {
                     a.k + 1
                 );
             }
-            // Exact duplicates are fitted once (copies would fill the neighbourhoods), and
-            // each copy takes its original's curvature.
-            let distinct = crease::spatial::distinct_in_input_order(&geom.points.positions);
-            let pts = distinct
-                .as_ref()
-                .map_or(geom.points.positions.as_slice(), |d| d.points.as_slice());
-            let stage = Stage::start(&format!("{}-nearest neighbours", a.k), g.quiet);
-            let nbrs = crease::spatial::knn(pts, a.k)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
-            stage.finish();
+            // One call: the k nearest neighbours among the distinct points (exact duplicates
+            // fitted once, each copy taking its original's estimate), then the fit.
             let stage = Stage::start("quadric curvature", g.quiet);
-            let params = QuadricParams { k: a.k };
-            let c = if a.use_normals {
-                let normals = geom.points.normals.as_ref().ok_or_else(|| {
+            let normals = if a.use_normals {
+                Some(geom.points.normals.as_deref().ok_or_else(|| {
                     usage(format!(
                         "{}: --use-normals given but the file has no normals",
                         a.input.display()
                     ))
-                })?;
-                match &distinct {
-                    Some(d) => quadric_curvature_oriented(pts, &nbrs, &d.pick(normals), &params)?,
-                    None => quadric_curvature_oriented(pts, &nbrs, normals, &params)?,
-                }
+                })?)
             } else {
-                quadric_curvature(pts, &nbrs, &params)?
+                None
             };
-            let c = match &distinct {
-                Some(d) => c.select(&d.of),
-                None => c,
-            };
+            let c =
+                quadric_curvature_of(&geom.points.positions, normals, &QuadricParams { k: a.k })
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
             stage.finish();
             summary["method"] = "quadric".into();
             summary["k"] = a.k.into();

@@ -175,6 +175,38 @@ impl Default for QuadricParams {
     }
 }
 
+/// [`quadric_curvature`] (or [`quadric_curvature_oriented`] with `normals`) of a point cloud in
+/// one call: its `params.k` nearest neighbours, found among its distinct points (exact
+/// duplicates are fitted once, and each copy takes its original's estimate).
+///
+/// Errors: fewer than `params.k + 1` distinct points, non-finite coordinates, `params.k < 5`,
+/// `normals` not one per point.
+pub fn quadric_curvature_of(
+    points: &[Point3],
+    normals: Option<&[Point3]>,
+    params: &QuadricParams,
+) -> Result<Curvature> {
+    if normals.is_some_and(|n| n.len() != points.len()) {
+        return Err(crate::Error::InvalidInput(format!(
+            "{} normals for {} points",
+            normals.map_or(0, <[Point3]>::len),
+            points.len()
+        )));
+    }
+    let distinct = crate::spatial::distinct_in_input_order(points);
+    let pts = distinct.as_ref().map_or(points, |d| d.points.as_slice());
+    let nbrs = crate::spatial::knn(pts, params.k)?;
+    let c = match (normals, &distinct) {
+        (Some(n), Some(d)) => quadric_curvature_oriented(pts, &nbrs, &d.pick(n), params)?,
+        (Some(n), None) => quadric_curvature_oriented(pts, &nbrs, n, params)?,
+        (None, _) => quadric_curvature(pts, &nbrs, params)?,
+    };
+    Ok(match &distinct {
+        Some(d) => c.select(&d.of),
+        None => c,
+    })
+}
+
 /// Quadric-fit curvature of every point of a cloud (see the module documentation), with
 /// unoriented normals: each point's normal is oriented so that its mean curvature is ≥ 0.
 ///
