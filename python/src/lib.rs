@@ -598,13 +598,7 @@ fn lines<'py>(
     let (lines, idx) = polylines(py, &net.vertices, &net.polylines)?;
     d.set_item("polylines", lines)?;
     d.set_item("indices", idx)?;
-    d.set_item(
-        "groups",
-        net.boundary_lines
-            .iter()
-            .map(|&b| if b { names::BOUNDARY } else { names::SHARP })
-            .collect::<Vec<_>>(),
-    )?;
+    d.set_item("groups", net.groups())?;
     d.set_item("clusters", vec_array(py, net.segmentation.labels.clone()))?;
     let s = serde_json::json!({
         "clusters": net.segmentation.num_clusters(),

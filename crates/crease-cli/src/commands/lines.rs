@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use crease::geometry::{names, Attribute, PointCloud};
+use crease::geometry::{Attribute, PointCloud};
 use crease::io::Geometry;
 use crease::lines::{extract_lines, LinesParams};
 
@@ -104,11 +104,7 @@ pub fn run(g: &Global, a: &LinesArgs) -> anyhow::Result<()> {
     let mut out = Geometry::from_cloud(PointCloud::from_positions(net.vertices.clone()));
     out.polylines = net.polylines.clone();
     // OBJ groups: the feature lines, and the cloud's open border apart.
-    out.polyline_groups = net
-        .boundary_lines
-        .iter()
-        .map(|&b| if b { names::BOUNDARY } else { names::SHARP }.to_string())
-        .collect();
+    out.polyline_groups = net.groups().iter().map(|g| g.to_string()).collect();
     super::save(g, &a.output, &out, a.ascii, &[&a.input])?;
     if let Some(path) = &a.segmentation {
         let mut cloud = geom.points.clone();

@@ -43,7 +43,7 @@ use crate::segment::{
     estimated_normals, neighbours_needed, segment_core, PointParams, PointSegmentation,
     SegmentParams,
 };
-use crate::spatial::{knn, morton_order_unique, Neighborhoods};
+use crate::spatial::{gather, knn, morton_order_unique, Neighborhoods};
 use crate::{Error, Result};
 
 /// The default neighbour count of the one query: the largest scale of
@@ -131,8 +131,7 @@ struct Counters {
 pub struct CloudAnalysis {
     params: AnalysisParams,
     order: Vec<u32>,
-    /// `rank[i]`: the row of input point i; empty when there are no duplicates (`order` is then
-    /// a permutation).
+    /// `rank[i]`: the row of input point i.
     rank: Vec<u32>,
     points: Vec<Point3>,
     neighbours: OnceLock<Neighborhoods>,
@@ -180,7 +179,6 @@ impl CloudAnalysis {
                 points.len()
             );
         }
-        let rank = if duplicates > 0 { rank } else { Vec::new() };
         let sorted = order.par_iter().map(|&i| points[i as usize]).collect();
         Ok(CloudAnalysis {
             params,
@@ -248,13 +246,14 @@ impl CloudAnalysis {
         &self.order
     }
 
+    /// `rows()[i]` is the row (in [`CloudAnalysis::points`]) of input point i.
+    pub fn rows(&self) -> &[u32] {
+        &self.rank
+    }
+
     /// The number of input points (distinct or not).
     pub fn input_len(&self) -> usize {
-        if self.rank.is_empty() {
-            self.order.len()
-        } else {
-            self.rank.len()
-        }
+        self.rank.len()
     }
 
     /// Input points that repeat an earlier one exactly (analysed as that one).
@@ -264,16 +263,8 @@ impl CloudAnalysis {
 
     /// Per-point values in the analysis' (sorted) order, put back into the input order; each
     /// duplicate takes its first copy's value.
-    pub fn to_input_order<T: Copy + Default + Send + Sync>(&self, sorted: &[T]) -> Vec<T> {
-        if self.rank.is_empty() {
-            let mut out = vec![T::default(); sorted.len()];
-            for (r, &i) in self.order.iter().enumerate() {
-                out[i as usize] = sorted[r];
-            }
-            out
-        } else {
-            self.rank.par_iter().map(|&r| sorted[r as usize]).collect()
-        }
+    pub fn to_input_order<T: Copy + Send + Sync>(&self, sorted: &[T]) -> Vec<T> {
+        gather(&self.rank, sorted)
     }
 
     /// The `max_k` nearest neighbours of every (sorted) point, nearest first.

@@ -369,15 +369,22 @@ pub fn extract_fillets(
         return extract_fillets_with(points, &first, params, with_sharp);
     };
     let first = lines::first_order(&distinct.points, &params.lines)?;
-    let mut f = extract_fillets_with(&distinct.points, &first, params, with_sharp)?;
-    f.region = distinct.expand(&f.region);
-    f.curvature = distinct.expand(&f.curvature);
-    f.label = distinct.expand(&f.label);
-    f.patch = distinct.expand(&f.patch);
+    let f = extract_fillets_with(&distinct.points, &first, params, with_sharp)?;
+    Ok(per_input_point(f, &distinct.of))
+}
+
+/// `f` computed on some rows of points, its per-point outputs given to every input point
+/// (`rows[i]`: input point i's row).
+fn per_input_point(mut f: Fillets, rows: &[u32]) -> Fillets {
+    use crate::spatial::gather;
+    f.region = gather(rows, &f.region);
+    f.curvature = gather(rows, &f.curvature);
+    f.label = gather(rows, &f.label);
+    f.patch = gather(rows, &f.patch);
     if let Some(net) = f.sharp.as_mut() {
-        net.segmentation.labels = distinct.expand(&net.segmentation.labels);
+        net.segmentation.labels = gather(rows, &net.segmentation.labels);
     }
-    Ok(f)
+    f
 }
 
 /// [`extract_fillets`] on a shared analysis of the cloud: the first-order structure is built
@@ -393,15 +400,8 @@ pub fn extract_fillets_from(
     check_params(params)?;
     let points = analysis.points();
     let first = lines::first_order_with(points, analysis.neighbours()?, &params.lines)?;
-    let mut f = extract_fillets_with(points, &first, params, with_sharp)?;
-    f.region = analysis.to_input_order(&f.region);
-    f.curvature = analysis.to_input_order(&f.curvature);
-    f.label = analysis.to_input_order(&f.label);
-    f.patch = analysis.to_input_order(&f.patch);
-    if let Some(net) = f.sharp.as_mut() {
-        net.segmentation.labels = analysis.to_input_order(&net.segmentation.labels);
-    }
-    Ok(f)
+    let f = extract_fillets_with(points, &first, params, with_sharp)?;
+    Ok(per_input_point(f, analysis.rows()))
 }
 
 /// [`extract_fillets`] on a first-order structure already computed for `points` with

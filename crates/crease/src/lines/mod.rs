@@ -156,6 +156,16 @@ impl LineNetwork {
         self.counts().closed_loops
     }
 
+    /// Per polyline, its group: [`crate::geometry::names::BOUNDARY`] along the cloud's open
+    /// border, else [`crate::geometry::names::SHARP`] (the OBJ `g` the CLI writes).
+    pub fn groups(&self) -> Vec<&'static str> {
+        use crate::geometry::names;
+        self.boundary_lines
+            .iter()
+            .map(|&b| if b { names::BOUNDARY } else { names::SHARP })
+            .collect()
+    }
+
     fn counts(&self) -> crate::geometry::NetworkCounts {
         crate::geometry::network_counts(self.vertices.len(), &self.edges, &self.polylines)
     }

@@ -70,7 +70,7 @@ use crate::estimate::orient::orient_normals_k;
 use crate::estimate::{pca_normals, PcaParams};
 use crate::geometry::vec3::{dist, dot, normalize};
 use crate::geometry::{Aabb, Csr, Point3};
-use crate::spatial::{knn, morton_order_unique, Adjacency, Neighborhoods};
+use crate::spatial::{gather, knn, morton_order_unique, Adjacency, Neighborhoods};
 use crate::{Error, Result};
 
 use crate::geometry::surface::signed_distance;
@@ -172,13 +172,10 @@ pub fn segment_points(
     let sorted_normals: Option<Vec<Point3>> =
         normals.map(|n| order.par_iter().map(|&i| n[i as usize]).collect());
     let mut seg = segment_ordered(&sorted, sorted_normals.as_deref(), params, pp)?;
-    fn unsort<T: Copy + Send + Sync>(rank: &[u32], v: &[T]) -> Vec<T> {
-        rank.par_iter().map(|&r| v[r as usize]).collect()
-    }
-    seg.point_surface = unsort(&rank, &seg.point_surface);
-    seg.point_labels = unsort(&rank, &seg.point_labels);
-    seg.sharp = unsort(&rank, &seg.sharp);
-    seg.point_area = unsort(&rank, &seg.point_area);
+    seg.point_surface = gather(&rank, &seg.point_surface);
+    seg.point_labels = gather(&rank, &seg.point_labels);
+    seg.sharp = gather(&rank, &seg.sharp);
+    seg.point_area = gather(&rank, &seg.point_area);
     Ok(seg)
 }
 

@@ -16,7 +16,7 @@ pub use knn::{
     check_extent, check_shape, knn, knn_map, knn_map_set, knn_map_set_unzip, knn_with, KnnMethod,
     KnnQuery, Neighborhoods,
 };
-pub use morton::{distinct_in_input_order, morton_order, morton_order_unique};
+pub use morton::{distinct_in_input_order, gather, morton_order, morton_order_unique, Distinct};
 pub use radius::{knn_within, radius_neighbors};
 pub use ring::{delaunay_rings, RingParams, Rings};
 pub use spacing::{average_spacing, average_spacing_with};

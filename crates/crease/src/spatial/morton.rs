@@ -287,11 +287,14 @@ impl Distinct {
 
     /// Per-distinct-point results for every input point: each copy takes its original's.
     pub fn expand<T: Copy + Send + Sync>(&self, per_distinct: &[T]) -> Vec<T> {
-        self.of
-            .par_iter()
-            .map(|&u| per_distinct[u as usize])
-            .collect()
+        gather(&self.of, per_distinct)
     }
+}
+
+/// `values[rows[i]]` for every i: per-row results given to the input points (`rows[i]`: the
+/// row of input point i, e.g. [`Distinct::of`]).
+pub fn gather<T: Copy + Send + Sync>(rows: &[u32], values: &[T]) -> Vec<T> {
+    rows.par_iter().map(|&r| values[r as usize]).collect()
 }
 
 /// The distinct points of `points` in input order, when some repeat exactly (equal
