@@ -17,7 +17,7 @@ if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip
-"$venv/bin/python" -m pip install --quiet maturin numpy pytest
+"$venv/bin/python" -m pip install --quiet maturin numpy pytest "dask[distributed]" tqdm
 # Builds the extension in release mode into python/target (the lock file python/Cargo.lock
 # holds the library's dependencies at the workspace's versions).
 "$venv/bin/python" -m pip install --quiet --force-reinstall --no-deps ./python

@@ -31,12 +31,16 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _crease
-from ._errors import FileFormatError
+from ._batch import BatchReport, batch
+from ._errors import CommandError, FileFormatError
 
 __version__ = _crease.__version__
 
 __all__ = [
     "FileFormatError",
+    "CommandError",
+    "BatchReport",
+    "RunResult",
     "Geometry",
     "SharpResult",
     "CurvatureResult",
@@ -55,6 +59,9 @@ __all__ = [
     "network",
     "edges",
     "reconstruct",
+    "run",
+    "command",
+    "batch",
     "set_num_threads",
     "SURFACE_TYPES",
 ]
@@ -293,6 +300,53 @@ class Reconstruction(_Record):
         "report",
         "topology",
         "uncertainty",
+        "seconds",
+    )
+
+
+class RunResult(_Record):
+    """The whole job (:func:`run`, the CLI's ``crease run``) from one shared analysis.
+
+    Attributes:
+        mesh: True for a mesh (per-edge and per-face results), False for a cloud (per point).
+        sharp, sharpness: cloud: per point (``labels.ply``'s ``sharp``, ``sharpness``); mesh: per
+            edge of ``edges``.
+        edges: mesh: (m, 2) int64 vertex indices of every edge (None for a cloud).
+        labels, types: surface id (-1: none) and type code (:data:`SURFACE_TYPES`) per point or
+            per face.
+        surfaces, surface_groups: the surfaces with their parameters (``surfaces.json``).
+        fillet_label, smooth_edge: cloud: the per-point fillet labels (None for a mesh).
+        polylines, polyline_groups, polyline_indices, polyline_vertices: the curve network
+            (``network.obj``): per polyline an (m, 3) array and its group (``"sharp"``,
+            ``"smooth"``, ``"boundary"``).
+        step: the B-rep as STEP text (``part.step``), None when none could be built.
+        brep: ``solid``, ``faces``, ``edges``, ``report``; or ``error`` saying why there is none.
+        noise_ratio, regularized, analysis: cloud: the measured noise, whether the sharp labels
+            were regularised, and how often each shared piece was computed (1 each).
+        timings, seconds: seconds per stage and in all.
+    """
+
+    _fields = (
+        "mesh",
+        "sharp",
+        "sharpness",
+        "edges",
+        "labels",
+        "types",
+        "surfaces",
+        "surface_groups",
+        "fillet_label",
+        "smooth_edge",
+        "polylines",
+        "polyline_groups",
+        "polyline_indices",
+        "polyline_vertices",
+        "step",
+        "brep",
+        "noise_ratio",
+        "regularized",
+        "analysis",
+        "timings",
         "seconds",
     )
 
@@ -783,6 +837,27 @@ def reconstruct(
     )
     d["topology"] = json.loads(d["topology"])
     return Reconstruction(**d)
+
+
+def run(points: Any, faces: Any = None, name: str = "part", units: str = "mm") -> RunResult:
+    """The whole job, as ``crease run``, from one shared analysis: a cloud's sharp points, curve
+    network (sharp, fillet and open-border lines), analytic surfaces and B-rep; a mesh's
+    feature edges, their polylines, its surfaces and its B-rep (with ``faces`` or a mesh
+    object). ``name`` and ``units``: the STEP file's product name and length unit. Bit for bit
+    the values of the files ``crease run`` writes."""
+    p, f, _ = _shape(points, faces)
+    d = _crease.run(p, faces=f, name=str(name), units=str(units))
+    for key in ("edges", "fillet_label", "smooth_edge", "noise_ratio", "regularized", "analysis"):
+        d.setdefault(key, None)
+    return RunResult(**d)
+
+
+def command(args: Sequence[str]) -> None:
+    """Runs one ``crease`` command line in this process (the CLI's own code; ``args`` without
+    the program name), e.g. ``crease.command(["sharp", "scan.ply", "-o", "out.ply"])``.
+    Prints what the CLI prints; raises :class:`CommandError` (with the CLI's ``code`` and
+    ``message``) when it fails."""
+    _crease.command([os.fspath(a) for a in args], True)
 
 
 def set_num_threads(n: int) -> None:

@@ -16,3 +16,18 @@ def os_error(code: int, message: str) -> OSError:
     e = cls(message)
     e.errno = code
     return e
+
+
+class CommandError(RuntimeError):
+    """A ``crease`` command line run by :func:`crease.command` (or a task of
+    :func:`crease.batch`) failed.
+
+    ``code`` is the CLI's exit code (1: the input or the computation failed, 2: a usage error such
+    as an unknown option) and ``message`` its message (``FILE: what is wrong``; empty for a usage
+    error, whose text the CLI has printed on stderr).
+    """
+
+    def __init__(self, code: int, message: str) -> None:
+        super().__init__(message or f"the command line was refused (exit code {code})")
+        self.code = code
+        self.message = message

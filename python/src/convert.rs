@@ -45,6 +45,19 @@ fn os_error(py: Python<'_>, code: i32, msg: String) -> PyErr {
     }
 }
 
+/// `crease.CommandError(code, msg)`: a command line run by `crease.command` failed (see
+/// `crease/_errors.py`); a `RuntimeError` if that module cannot be imported.
+pub fn command_error(py: Python<'_>, code: u8, msg: String) -> PyErr {
+    match py
+        .import("crease._errors")
+        .and_then(|m| m.getattr("CommandError"))
+        .and_then(|c| c.call1((code, msg.clone())))
+    {
+        Ok(obj) => PyErr::from_value(obj),
+        Err(_) => PyRuntimeError::new_err(msg),
+    }
+}
+
 /// `crease.FileFormatError(msg)`, defined in Python (it derives from both `OSError` and
 /// `ValueError`, which a native exception type cannot); a plain `ValueError` if that module
 /// cannot be imported.

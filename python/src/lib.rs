@@ -979,6 +979,154 @@ fn reconstruct<'py>(
     Ok(d)
 }
 
+/// `crease run` on arrays: the whole job from one shared analysis (`crease::pipeline`).
+#[pyfunction]
+#[pyo3(signature = (points, faces = None, name = "part", units = "mm"))]
+fn run<'py>(
+    py: Python<'py>,
+    points: Points<'py>,
+    faces: Option<Faces<'py>>,
+    name: &str,
+    units: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let unit: crease::brep::LengthUnit = units.parse().map_err(value_error)?;
+    let (pos, faces) = shape_input(&points, faces.as_ref())?;
+    let on_mesh = faces.as_ref().is_some_and(|f| !f.is_empty());
+    let d = PyDict::new(py);
+    d.set_item("mesh", on_mesh)?;
+    let name = name.to_string();
+    // The B-rep as the CLI writes it (its STEP text), or why there is none.
+    let step = move |rec: &crease::Result<crease::brep::Reconstruction>, positions: &[[f64; 3]]| {
+        rec.as_ref().map_err(|e| e.to_string()).map(|rec| {
+            let size = crease::Aabb::from_points(positions)
+                .map(|b| b.diagonal())
+                .unwrap_or(1.0);
+            let report = serde_json::to_value(&rec.report).unwrap_or_default();
+            (
+                rec.to_step(&name, unit, size),
+                report,
+                rec.brep.faces.len(),
+                rec.brep.edges.len(),
+            )
+        })
+    };
+    let start = Instant::now();
+    let brep = if on_mesh {
+        let (r, brep, positions) = compute(py, move || {
+            let mesh = TriMesh::new(pos, faces.unwrap_or_default())?;
+            let r = crease::pipeline::run_mesh(&mesh, |_| {})?;
+            let brep = step(&r.brep, &mesh.vertices.positions);
+            Ok((r, brep, mesh.vertices.positions))
+        })?;
+        let seg = &r.segmentation;
+        d.set_item("edges", index_array(py, &r.edges)?)?;
+        d.set_item("sharp", vec_array(py, r.detection.sharp.clone()))?;
+        d.set_item("sharpness", vec_array(py, r.detection.sharpness.clone()))?;
+        d.set_item("labels", vec_array(py, seg.face_surface.clone()))?;
+        d.set_item("types", vec_array(py, seg.face_types()))?;
+        d.set_item("surfaces", to_py(py, &seg.surfaces)?)?;
+        d.set_item("surface_groups", to_py(py, &seg.groups)?)?;
+        let (lines, idx) = polylines(py, &positions, &r.polylines)?;
+        d.set_item("polylines", lines)?;
+        d.set_item("polyline_indices", idx)?;
+        d.set_item("polyline_groups", vec![names::SHARP; r.polylines.len()])?;
+        d.set_item("polyline_vertices", points_array(py, positions)?)?;
+        d.set_item("timings", to_py(py, &timings_map(&r.timings))?)?;
+        brep
+    } else {
+        let (r, brep) = compute(py, move || {
+            let analysis = CloudAnalysis::new(&pos, AnalysisParams::default())?;
+            let r = crease::pipeline::run_cloud(&analysis, |_| {})?;
+            let brep = step(&r.brep, &pos);
+            Ok((r, brep))
+        })?;
+        let net = &r.network;
+        let code = |l: Option<Label>| l.map_or(255u8, |l| l as u8);
+        d.set_item("sharp", vec_array(py, r.sharp.sharp.clone()))?;
+        d.set_item("sharpness", vec_array(py, r.sharp.sharpness.clone()))?;
+        d.set_item("noise_ratio", r.sharp.noise_ratio)?;
+        d.set_item("regularized", r.sharp.regularized)?;
+        d.set_item("labels", vec_array(py, r.surface.clone()))?;
+        d.set_item("types", vec_array(py, r.surface_type.clone()))?;
+        d.set_item(
+            "fillet_label",
+            vec_array(
+                py,
+                r.fillets
+                    .label
+                    .iter()
+                    .map(|&l| code(l))
+                    .collect::<Vec<u8>>(),
+            ),
+        )?;
+        d.set_item(
+            "smooth_edge",
+            vec_array(
+                py,
+                r.fillets
+                    .label
+                    .iter()
+                    .map(|&l| l == Some(Label::Border))
+                    .collect::<Vec<bool>>(),
+            ),
+        )?;
+        d.set_item("surfaces", to_py(py, &r.surfaces)?)?;
+        d.set_item("surface_groups", to_py(py, &r.groups)?)?;
+        let (lines, idx) = polylines(py, &net.vertices, &net.polylines)?;
+        d.set_item("polylines", lines)?;
+        d.set_item("polyline_indices", idx)?;
+        d.set_item("polyline_groups", net.groups())?;
+        d.set_item("polyline_vertices", points_array(py, net.vertices.clone())?)?;
+        d.set_item("analysis", to_py(py, &r.counts)?)?;
+        d.set_item("timings", to_py(py, &timings_map(&r.timings))?)?;
+        brep
+    };
+    d.set_item("seconds", start.elapsed().as_secs_f64())?;
+    match brep {
+        Ok((text, report, faces, edges)) => {
+            d.set_item("step", text)?;
+            let b = serde_json::json!({
+                "solid": report.get("closed").cloned().unwrap_or_default(),
+                "faces": faces,
+                "edges": edges,
+                "report": report,
+            });
+            d.set_item("brep", json_to_py(py, &b)?)?;
+        }
+        Err(e) => {
+            d.set_item("step", py.None())?;
+            d.set_item("brep", json_to_py(py, &serde_json::json!({ "error": e }))?)?;
+        }
+    }
+    Ok(d)
+}
+
+/// Runs one `crease` command line in this process (the CLI's own code, `crease_cli`), the GIL
+/// released. `args` without the program name. Returns the exit code having printed what the
+/// binary prints when `check` is false (the console command); raises `crease.CommandError`
+/// with the CLI's message and exit code when `check` is true and the command fails.
+#[pyfunction]
+#[pyo3(signature = (args, check = true))]
+fn command(py: Python<'_>, args: Vec<std::ffi::OsString>, check: bool) -> PyResult<u8> {
+    let argv = std::iter::once(std::ffi::OsString::from("crease")).chain(args);
+    let r = py.detach(|| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || {
+            if check {
+                crease_cli::try_main_with_args(argv).map(|()| 0)
+            } else {
+                Ok(crease_cli::main_with_args(argv))
+            }
+        }))
+    });
+    match r {
+        Ok(Ok(code)) => Ok(code),
+        Ok(Err(f)) => Err(convert::command_error(py, f.code, f.message)),
+        Err(_) => Err(pyo3::exceptions::PyRuntimeError::new_err(
+            "internal error in crease (please report it): a panic in the command",
+        )),
+    }
+}
+
 /// Writes `text` to `path` atomically (the CLI's `ui::write_text`).
 fn write_text(path: &std::path::Path, text: &str) -> crease::Result<()> {
     crease::io::atomic::replace(path, |tmp| {
@@ -1019,5 +1167,7 @@ fn _crease(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(edges, m)?)?;
     m.add_function(wrap_pyfunction!(reconstruct, m)?)?;
     m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(command, m)?)?;
     Ok(())
 }

@@ -4,7 +4,7 @@
 //! A point cloud gets its sharp points, its curve network (sharp and fillet lines) and its
 //! analytic surfaces from one neighbour query and one segmentation; a triangle mesh gets its
 //! feature edges (the default `fused` method), their polylines and its segmentation into
-//! surfaces. DIR receives:
+//! surfaces (`crease::pipeline`). DIR receives:
 //!
 //! | file | cloud | mesh |
 //! |---|---|---|
@@ -21,14 +21,13 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use crease::analysis::{AnalysisParams, CloudAnalysis};
-use crease::brep::{reconstruct_cloud, reconstruct_segmented_mesh, LengthUnit};
-use crease::fillets::{curve_network, extract_fillets_from, FilletParams, Label};
+use crease::brep::LengthUnit;
+use crease::fillets::Label;
 use crease::geometry::{names, Attribute, PointCloud, ScalarKind, TriMesh};
 use crease::io::Geometry;
-use crease::meshfeat::{detect_edges, feature_polylines, EdgeParams};
+use crease::pipeline::{run_cloud as run_cloud_job, run_mesh as run_mesh_job};
 use crease::render::{ColorBy, Polyline, RenderParams, Scene};
-use crease::segment::{segment_mesh, SegmentParams, SegmentSurface};
-use crease::sharp::{detect, SharpParams};
+use crease::segment::SegmentSurface;
 
 use crate::args::Global;
 use crate::ui::{usage, Stage};
@@ -101,49 +100,67 @@ pub fn run(g: &Global, a: &RunArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Shows each stage of a [`crease::pipeline`] run while it computes.
+struct Progress {
+    quiet: bool,
+    current: Option<Stage>,
+}
+
+impl Progress {
+    fn new(quiet: bool) -> Progress {
+        Progress {
+            quiet,
+            current: None,
+        }
+    }
+
+    fn start(&mut self, stage: crease::pipeline::Stage) {
+        self.end();
+        self.current = Some(Stage::start(stage.what, self.quiet));
+    }
+
+    fn end(&mut self) {
+        if let Some(s) = self.current.take() {
+            s.finish();
+        }
+    }
+}
+
+/// Seconds per stage as a JSON object.
+fn timings_json(t: &[(&'static str, f64)]) -> serde_json::Map<String, serde_json::Value> {
+    t.iter()
+        .map(|(k, v)| (k.to_string(), serde_json::json!(v)))
+        .collect()
+}
+
 /// The cloud path: one analysis, then sharp points, the curve network and the surfaces.
 fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_json::Value> {
     let name = a.input.display().to_string();
-    let mut timings = serde_json::Map::new();
-    let mut timed = |label: &str, stage: Stage| {
-        timings.insert(label.to_string(), serde_json::json!(stage.finish()));
-    };
     let points = &geom.points.positions;
     let analysis =
         CloudAnalysis::new(points, AnalysisParams::default()).with_context(|| name.clone())?;
+    let mut progress = Progress::new(g.quiet);
+    let run = run_cloud_job(&analysis, |s| progress.start(s)).with_context(|| name.clone());
+    progress.end();
+    let run = run?;
+    let sharp = &run.sharp;
+    let network = &run.network;
 
-    let s = Stage::start("neighbours", g.quiet);
-    analysis.neighbours().with_context(|| name.clone())?;
-    timed("neighbours", s);
-    let s = Stage::start("segmentation into analytic surfaces", g.quiet);
-    let seg = analysis.segmentation().with_context(|| name.clone())?;
-    timed("segmentation", s);
-    let s = Stage::start("sharp points", g.quiet);
-    let sharp = detect(&analysis, &SharpParams::default()).with_context(|| name.clone())?;
-    timed("sharp_points", s);
-    let s = Stage::start("curve network (sharp + fillet lines)", g.quiet);
-    let fillets = extract_fillets_from(&analysis, &FilletParams::default(), true)
-        .with_context(|| name.clone())?;
-    let network = curve_network(&fillets);
-    timed("curve_network", s);
-
-    let surface = analysis.to_input_order(&seg.point_surface);
-    let types = analysis.to_input_order(&seg.point_types());
     let mut cloud = geom.points.clone();
     cloud.set_attribute(Attribute::flag(names::SHARP, sharp.sharp.iter().copied()))?;
     cloud.set_attribute(Attribute::float(names::SHARPNESS, sharp.sharpness.clone()))?;
     cloud.set_attribute(Attribute::int(
         names::SURFACE,
-        surface.iter().map(|&s| i64::from(s)),
+        run.surface.iter().map(|&s| i64::from(s)),
     ))?;
-    cloud.set_attribute(uchar(names::SURFACE_TYPE, types.iter().copied()))?;
+    cloud.set_attribute(uchar(names::SURFACE_TYPE, run.surface_type.iter().copied()))?;
     cloud.set_attribute(uchar(
         names::FILLET_LABEL,
-        fillets.label.iter().map(|l| l.map_or(255, |l| l as u8)),
+        run.fillets.label.iter().map(|l| l.map_or(255, |l| l as u8)),
     ))?;
     cloud.set_attribute(Attribute::flag(
         names::SMOOTH_EDGE,
-        fillets.label.iter().map(|&l| l == Some(Label::Border)),
+        run.fillets.label.iter().map(|&l| l == Some(Label::Border)),
     ))?;
     let labels = Geometry::from_cloud(cloud);
     super::save(
@@ -158,13 +175,8 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     net.polylines = network.polylines.clone();
     net.polyline_groups = network.groups().iter().map(|g| g.to_string()).collect();
     super::save(g, &a.output.join("network.obj"), &net, false, &[&a.input])?;
-    write_surfaces(&a.output, &seg.surfaces, &seg.groups, seg.mean_edge)?;
-
-    // The B-rep from the same analysis; a part it cannot close is reported, not fatal (the
-    // other outputs stand).
-    let s = Stage::start("B-rep (STEP)", g.quiet);
-    let brep = write_brep(a, &name, points, reconstruct_cloud(&analysis))?;
-    timed("brep", s);
+    write_surfaces(&a.output, &run.surfaces, &run.groups, run.mean_edge)?;
+    let brep = write_brep(a, &name, points, &run.brep)?;
 
     let sharp_lines = network.count(names::SHARP);
     let smooth_lines = network.count(names::SMOOTH);
@@ -175,30 +187,30 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
             .zip(network.groups())
             .map(|(l, group)| picture_line(l, &network.vertices, group))
             .collect();
-        picture(a, &labels, None, lines, seg.surfaces.len())?;
+        picture(a, &labels, None, lines, run.surfaces.len())?;
     }
-    let assigned = surface.iter().filter(|&&s| s >= 0).count();
+    let assigned = run.surface.iter().filter(|&&s| s >= 0).count();
     Ok(serde_json::json!({
         "kind": "cloud",
         "points": points.len(),
         "sharp_points": sharp.num_sharp(),
         "noise_ratio": sharp.noise_ratio,
         "regularized": sharp.regularized,
-        "surfaces": seg.surfaces.len(),
+        "surfaces": run.surfaces.len(),
         "assigned_points": assigned,
         "sharp_polylines": sharp_lines,
         "smooth_polylines": smooth_lines,
         "boundary_polylines": network.count(names::BOUNDARY),
         "joined_smooth_ends": network.joined_ends,
         "open_smooth_ends": network.open_ends,
-        "analysis": analysis.counts(),
+        "analysis": run.counts,
         "brep": brep,
-        "timings": timings,
-        "segmentation_stages": seg.timings.iter().map(|(k, v)| (k.to_string(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+        "timings": timings_json(&run.timings),
+        "segmentation_stages": timings_json(&run.segmentation_timings),
         "sharp_surface_stage": sharp.surfaces,
         "line": format!(
             "{} sharp points, {} sharp and {} fillet polylines, {} surfaces ({} of {} points)",
-            sharp.num_sharp(), sharp_lines, smooth_lines, seg.surfaces.len(), assigned,
+            sharp.num_sharp(), sharp_lines, smooth_lines, run.surfaces.len(), assigned,
             points.len()
         ),
     }))
@@ -211,7 +223,7 @@ fn write_brep(
     a: &RunArgs,
     name: &str,
     points: &[crease::geometry::Point3],
-    rec: crease::Result<crease::brep::Reconstruction>,
+    rec: &crease::Result<crease::brep::Reconstruction>,
 ) -> anyhow::Result<serde_json::Value> {
     Ok(match rec {
         Ok(rec) => {
@@ -249,32 +261,24 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
     let mut mesh = geom
         .into_mesh()
         .with_context(|| format!("{name}: faces that are not a triangle mesh"))?;
-    let mut timings = serde_json::Map::new();
-    let s = Stage::start("feature edges", g.quiet);
-    let (em, det) = detect_edges(&mesh, &EdgeParams::default()).with_context(|| name.clone())?;
-    timings.insert("feature_edges".into(), serde_json::json!(s.finish()));
-    let edges = em.topo.edges().to_vec();
-    let lines = feature_polylines(&em.topo, &det.sharp);
-    // The segmentation reads the edge topology the feature edges were computed on.
-    let s = Stage::start("segmentation into analytic surfaces", g.quiet);
-    let seg =
-        segment_mesh(&mesh, &em.topo, &SegmentParams::default()).with_context(|| name.clone())?;
-    drop(em);
-    timings.insert("segmentation".into(), serde_json::json!(s.finish()));
-    let s = Stage::start("B-rep (STEP)", g.quiet);
-    let rec = reconstruct_segmented_mesh(&mesh, seg.clone(), &SegmentParams::default());
-    let brep = write_brep(a, &name, &mesh.vertices.positions, rec)?;
-    timings.insert("brep".into(), serde_json::json!(s.finish()));
+    let mut progress = Progress::new(g.quiet);
+    let run = run_mesh_job(&mesh, |s| progress.start(s)).with_context(|| name.clone());
+    progress.end();
+    let run = run?;
+    let seg = &run.segmentation;
+    let brep = write_brep(a, &name, &mesh.vertices.positions, &run.brep)?;
 
     mesh.set_face_attribute(Attribute::int(
         names::SURFACE,
         seg.face_surface.iter().map(|&s| i64::from(s)),
     ))?;
     mesh.set_face_attribute(uchar(names::SURFACE_TYPE, seg.face_types()))?;
-    let n_edges = edges.len();
+    let det = &run.detection;
+    let n_edges = run.edges.len();
     let n_sharp = det.sharp.iter().filter(|&&s| s).count();
+    let lines = &run.polylines;
     let mut out = Geometry::from_mesh(mesh);
-    out.edges = edges;
+    out.edges = run.edges.clone();
     out.edge_attributes.insert(
         n_edges,
         Attribute::flag(names::SHARP, det.sharp.iter().copied()),
@@ -308,7 +312,7 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
         "surfaces": seg.surfaces.len(),
         "assigned_faces": assigned,
         "brep": brep,
-        "timings": timings,
+        "timings": timings_json(&run.timings),
         "line": format!(
             "{n_sharp} of {n_edges} edges sharp in {} polylines, {} surfaces ({} of {} faces)",
             lines.len(), seg.surfaces.len(), assigned, out.faces.len()
