@@ -32,6 +32,7 @@ import numpy as np
 
 from . import _crease
 from ._batch import BatchReport, batch
+from ._tiled import tiled_sharp
 from ._errors import CommandError, FileFormatError
 
 __version__ = _crease.__version__
@@ -62,6 +63,7 @@ __all__ = [
     "run",
     "command",
     "batch",
+    "tiled_sharp",
     "set_num_threads",
     "SURFACE_TYPES",
 ]

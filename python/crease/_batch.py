@@ -132,6 +132,61 @@ def _result(fut: Any, job: Tuple[Any, ...]) -> Dict[str, Any]:
         return {"input": job[1], "output": job[2][0], "seconds": 0.0, "error": f"{job[1]}: the worker failed: {e!r}"}
 
 
+def _set_threads(n: Optional[int]) -> None:
+    """A pool worker's initialiser: its computations use ``n`` threads."""
+    if n:
+        from . import _crease
+
+        try:
+            _crease.set_num_threads(n)
+        except RuntimeError:
+            pass
+
+
+def map_tasks(
+    fn: Any,
+    jobs: Sequence[Any],
+    client: Any = None,
+    workers: int = 1,
+    threads: Optional[int] = None,
+    bar: Any = None,
+) -> List[Any]:
+    """``[fn(j) for j in jobs]`` run as tasks: on the dask ``client``'s workers, on a local pool
+    of ``workers`` fresh processes using ``threads`` threads each, or here when ``workers`` is
+    1. ``fn`` is a module-level function (pickled by reference). Results in the order of
+    ``jobs``; the first task that raises raises here."""
+    if not jobs:
+        return []
+    if client is not None:
+        futures = client.map(fn, jobs, pure=False)
+        if bar is not None:
+            from distributed import as_completed
+
+            for _ in as_completed(futures):
+                bar.update(1)
+        return client.gather(futures)
+    if workers <= 1:
+        out = []
+        for j in jobs:
+            out.append(fn(j))
+            if bar is not None:
+                bar.update(1)
+        return out
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
+    # Fresh interpreters: a forked child would inherit the parent's thread pools.
+    ctx = mp.get_context("spawn")
+    with cf.ProcessPoolExecutor(
+        max_workers=workers, mp_context=ctx, initializer=_set_threads, initargs=(threads,)
+    ) as pool:
+        futures = [pool.submit(fn, j) for j in jobs]
+        if bar is not None:
+            for _ in cf.as_completed(futures):
+                bar.update(1)
+        return [f.result() for f in futures]
+
+
 def _progress(total: int, enabled: bool) -> Any:
     """A tqdm bar when tqdm is installed and ``enabled``, else None."""
     if not enabled:

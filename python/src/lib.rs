@@ -13,6 +13,7 @@
 //! float64 / int64, wraps the dicts in result classes and documents the functions.
 
 mod convert;
+mod tiled;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -1169,5 +1170,14 @@ fn _crease(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(command, m)?)?;
+    m.add_function(wrap_pyfunction!(tiled::split_tiles, m)?)?;
+    m.add_function(wrap_pyfunction!(tiled::sample_spacing, m)?)?;
+    m.add_function(wrap_pyfunction!(tiled::halo_width, m)?)?;
+    m.add_function(wrap_pyfunction!(tiled::tile_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(tiled::noise_ratio_of, m)?)?;
+    m.add_function(wrap_pyfunction!(tiled::tile_measures, m)?)?;
+    m.add_function(wrap_pyfunction!(tiled::tile_histograms, m)?)?;
+    m.add_function(wrap_pyfunction!(tiled::sharp_thresholds, m)?)?;
+    m.add_function(wrap_pyfunction!(tiled::tile_labels, m)?)?;
     Ok(())
 }

@@ -37,7 +37,7 @@ use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
-use crate::estimate::noise::noise_ratio;
+use crate::estimate::noise::{noise_samples, ratio_of_samples, sample_stride};
 use crate::geometry::Point3;
 use crate::segment::{
     estimated_normals, neighbours_needed, segment_core, PointParams, PointSegmentation,
@@ -274,11 +274,19 @@ impl CloudAnalysis {
         })
     }
 
-    /// The noise ratio of [`crate::estimate::noise::noise_ratio`].
+    /// The noise ratio of [`crate::estimate::noise::noise_ratio`], its sample's stride set by
+    /// the number of input points (copies included), as a tiled run sets it
+    /// ([`crate::sharp::tiled`]).
     pub fn noise_ratio(&self) -> Result<f64> {
         let nbrs = self.neighbours()?;
         once(&self.noise, &self.counters.noise, || {
-            Ok(noise_ratio(&self.points, nbrs))
+            let stride = sample_stride(self.input_len());
+            Ok(ratio_of_samples(&mut noise_samples(
+                &self.points,
+                nbrs,
+                stride,
+                |_| true,
+            )))
         })
         .copied()
     }

@@ -20,8 +20,9 @@
 //!   than two orders of magnitude, so [`NOISY_RATIO`] is set between the noisiest synthetic
 //!   parts the tests use and the least noisy PCEDNet cloud, not tuned on the scores.
 //!
-//! At most [`SAMPLES`] points (every n/SAMPLES-th in input order) are measured, so the cost is
-//! bounded; the result does not depend on the thread count.
+//! At most about [`SAMPLES`] points (one in n/SAMPLES, chosen by a hash of the coordinates) are
+//! measured, so the cost is bounded; the result depends neither on the thread count nor on the
+//! order of the points, and a cloud cut into tiles gives the same (`crate::sharp::tiled`).
 
 use rayon::prelude::*;
 
@@ -48,17 +49,52 @@ pub const NOISY_RATIO: f64 = 0.08;
 /// `nbrs` must hold at least 3 neighbours per point (fewer of them are used when it holds fewer
 /// than [`NOISE_K`]). Returns 0 for an empty cloud or one whose points all coincide.
 pub fn noise_ratio(points: &[Point3], nbrs: &Neighborhoods) -> f64 {
+    let mut samples = noise_samples(points, nbrs, sample_stride(points.len()), |_| true);
+    ratio_of_samples(&mut samples)
+}
+
+/// The stride of the sample measured in a cloud of `n` points: at most about [`SAMPLES`] points.
+pub fn sample_stride(n: usize) -> usize {
+    n.div_ceil(SAMPLES).max(1)
+}
+
+/// Whether the point at `p` is one of the measured ones at `stride`: about one in `stride`
+/// points, chosen by a hash of its coordinates, so that the sample does not depend on the order
+/// of the points nor on how the cloud is cut into tiles ([`crate::sharp::tiled`]).
+fn sampled(p: Point3, stride: usize) -> bool {
+    if stride <= 1 {
+        return true;
+    }
+    // SplitMix64's finaliser over the three coordinates' bits.
+    let mut h = 0x9E37_79B9_7F4A_7C15u64;
+    for c in p {
+        h ^= c.to_bits();
+        h = (h ^ (h >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        h = (h ^ (h >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        h ^= h >> 31;
+    }
+    h.is_multiple_of(stride as u64)
+}
+
+/// The measured pairs (√λ0, distance to the nearest neighbour) of the sampled points among those
+/// for which `keep(i)` holds (a tile's core points); [`ratio_of_samples`] turns the samples of a
+/// whole cloud, in any order, into its ratio.
+pub fn noise_samples(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    stride: usize,
+    keep: impl Fn(usize) -> bool + Sync,
+) -> Vec<(f64, f64)> {
     let n = points.len().min(nbrs.len());
     let k = nbrs.k().min(NOISE_K);
     if n == 0 || k < 3 {
-        return 0.0;
+        return Vec::new();
     }
-    let stride = n.div_ceil(SAMPLES).max(1);
-    let sample: Vec<(f64, f64)> = (0..n.div_ceil(stride))
+    (0..n)
         .into_par_iter()
         .with_min_len(256)
-        .map(|s| {
-            let i = s * stride;
+        .filter(|&i| keep(i) && sampled(points[i], stride))
+        .map(|i| {
             let p = points[i];
             let row = nbrs.prefix(i, k);
             let nn = row
@@ -74,12 +110,21 @@ pub fn noise_ratio(points: &[Point3], nbrs: &Neighborhoods) -> f64 {
             let r = eig[0].max(0.0).sqrt();
             (if r.is_finite() { r } else { 0.0 }, nn)
         })
-        .collect();
-    let spacing = sample.iter().map(|s| s.1).sum::<f64>() / sample.len() as f64;
+        .collect()
+}
+
+/// The noise ratio of a cloud from its samples ([`noise_samples`]), whatever their order (they
+/// are sorted here, so the sum of the spacings is the same for any order).
+pub fn ratio_of_samples(samples: &mut [(f64, f64)]) -> f64 {
+    if samples.is_empty() {
+        return 0.0;
+    }
+    samples.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.total_cmp(&b.0)));
+    let spacing = samples.iter().map(|s| s.1).sum::<f64>() / samples.len() as f64;
     if !(spacing > 0.0 && spacing.is_finite()) {
         return 0.0;
     }
-    let mut res: Vec<f64> = sample.iter().map(|s| s.0).collect();
+    let mut res: Vec<f64> = samples.iter().map(|s| s.0).collect();
     let q = ((res.len() - 1) as f64 * NOISE_QUANTILE).round() as usize;
     let (_, v, _) = res.select_nth_unstable_by(q, f64::total_cmp);
     *v / spacing

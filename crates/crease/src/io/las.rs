@@ -95,7 +95,9 @@ pub fn read(path: &Path) -> Result<(Geometry, ReadReport)> {
     })
 }
 
-fn read_inner(path: &Path) -> Result<(Geometry, ReadReport)> {
+/// Opens a LAS / LAZ file for reading, after the checks that keep a corrupt header from
+/// allocating or decoding garbage (chunk table, announced size against the file's).
+fn open(path: &Path) -> Result<Reader> {
     let file_len = std::fs::metadata(path)
         .map_err(|e| Error::io(path, e))?
         .len();
@@ -113,9 +115,9 @@ fn read_inner(path: &Path) -> Result<(Geometry, ReadReport)> {
     if raw.point_data_record_format & 0x80 != 0 {
         check_chunk_table(path, u64::from(raw.offset_to_point_data), file_len)?;
     }
-    let mut reader =
+    let reader =
         Reader::from_path(path).map_err(|e| las_err(path, "cannot open the LAS/LAZ file", e))?;
-    let header = reader.header().clone();
+    let header = reader.header();
     let format = *header.point_format();
     let n = header.number_of_points();
     if !format.is_compressed {
@@ -134,6 +136,76 @@ fn read_inner(path: &Path) -> Result<(Geometry, ReadReport)> {
             ));
         }
     }
+    Ok(reader)
+}
+
+/// The point count and the bounding box a LAS / LAZ file's header announces.
+pub fn header_bounds(path: &Path) -> Result<(u64, [f64; 3], [f64; 3])> {
+    let reader = open(path)?;
+    let header = reader.header();
+    let b = header.bounds();
+    Ok((
+        header.number_of_points(),
+        [b.min.x, b.min.y, b.min.z],
+        [b.max.x, b.max.y, b.max.z],
+    ))
+}
+
+/// The positions of a LAS / LAZ file, handed to `f` in batches in file order without holding
+/// the file in memory (for clouds larger than memory, [`crate::io::tiles`]); returns the
+/// header's point count and bounding box.
+pub fn for_each_position(
+    path: &Path,
+    mut f: impl FnMut(&[[f64; 3]]) -> Result<()>,
+) -> Result<(u64, [f64; 3], [f64; 3])> {
+    catch_unwind(AssertUnwindSafe(|| {
+        let mut reader = open(path)?;
+        let header = reader.header().clone();
+        let n = header.number_of_points();
+        let b = header.bounds();
+        let mut pd: PointData = las::PointDataBuilder::new().for_header(&header).build();
+        let mut batch = Vec::new();
+        let mut read = 0u64;
+        loop {
+            let got = reader.fill_points(BATCH, &mut pd).map_err(|e| {
+                las_err(
+                    path,
+                    &format!("point {read}: cannot decode the point data"),
+                    e,
+                )
+            })?;
+            if got == 0 {
+                break;
+            }
+            read += got;
+            batch.clear();
+            batch.extend(pd.x().zip(pd.y()).zip(pd.z()).map(|((x, y), z)| [x, y, z]));
+            f(&batch)?;
+        }
+        if read < n {
+            return Err(Error::format(
+                path,
+                format!(
+                    "the header announces {n} points but only {read} could be read: the file is \
+                     truncated"
+                ),
+            ));
+        }
+        Ok((n, [b.min.x, b.min.y, b.min.z], [b.max.x, b.max.y, b.max.z]))
+    }))
+    .unwrap_or_else(|_| {
+        Err(Error::format(
+            path,
+            "the LAS/LAZ decoder failed on corrupt data",
+        ))
+    })
+}
+
+fn read_inner(path: &Path) -> Result<(Geometry, ReadReport)> {
+    let mut reader = open(path)?;
+    let header = reader.header().clone();
+    let format = *header.point_format();
+    let n = header.number_of_points();
     let mut positions = Vec::new();
     let mut intensity = Vec::new();
     let mut class = Vec::new();

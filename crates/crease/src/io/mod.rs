@@ -22,6 +22,7 @@ pub mod pcd;
 pub mod ply;
 pub mod stl;
 pub mod summary;
+pub mod tiles;
 pub mod xyz;
 
 /// Everything a file may hold: points (with per-point data), triangles, and line segments /

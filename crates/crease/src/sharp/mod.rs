@@ -82,6 +82,7 @@ pub mod potts;
 mod rim;
 pub mod surfaces;
 mod thin;
+pub mod tiled;
 
 pub use crate::estimate::noise;
 pub use measures::Measure;
@@ -408,83 +409,21 @@ fn detect_core<'s>(
         )));
     }
     let ratio = ratio.unwrap_or_else(|| noise::noise_ratio(points, nbrs));
-    let per_scale: Vec<Vec<f64>> = if matches!(
-        params.measure,
-        Measure::ProjectedDistance | Measure::SurfaceVariation
-    ) {
-        // Every scale from one gathering of the largest neighbourhood per point.
-        let ns = scales.len();
-        // The one-face test compares chord angles of 15°: on clouds whose noise is a sizeable
-        // fraction of the spacing (the regularised ones) it drops neighbours at random.
-        let face_normals = (params.one_face && ratio <= noise::NOISY_RATIO)
-            .then(|| face::face_normals(points, nbrs));
-        let test = face::SheetTest::default();
-        let mut flat = vec![0.0f64; points.len() * ns];
-        flat.par_chunks_mut(ns)
-            .enumerate()
-            .with_min_len(256)
-            .for_each_init(
-                || (Vec::new(), Vec::new(), vec![0usize; ns], Vec::new()),
-                |(coords, work, ends, cum): &mut Gather, (i, out)| {
-                    let p = points[i];
-                    coords.clear();
-                    coords.push(p);
-                    let row = nbrs.prefix(i, kmax);
-                    match &face_normals {
-                        Some(m) => {
-                            // The neighbours on the point's own sheet; scale s keeps those among
-                            // its scales[s] nearest.
-                            let mp = m[i];
-                            cum.clear();
-                            cum.push(1);
-                            for &j in row {
-                                let q = points[j as usize];
-                                if !test.other_sheet(p, mp, q, m[j as usize]) {
-                                    coords.push(q);
-                                }
-                                cum.push(coords.len());
-                            }
-                            for (e, &k) in ends.iter_mut().zip(&scales) {
-                                *e = cum[k.min(row.len())];
-                            }
-                        }
-                        None => {
-                            coords.extend(row.iter().map(|&j| points[j as usize]));
-                            for (e, &k) in ends.iter_mut().zip(&scales) {
-                                *e = k + 1;
-                            }
-                        }
-                    }
-                    measures::pca_measure_scales(
-                        coords,
-                        ends,
-                        params.measure,
-                        params.pca_weight,
-                        params.density_invariant,
-                        work,
-                        out,
-                    );
-                },
-            );
-        (0..ns)
-            .map(|s| flat.par_chunks(ns).map(|row| row[s]).collect())
-            .collect()
-    } else {
-        scales
-            .iter()
-            .map(|&k| {
-                measures::measure_at_scale(
-                    points,
-                    |i| nbrs.prefix(i, k),
-                    None,
-                    params.measure,
-                    params.pca_weight,
-                    params.density_invariant,
-                )
-            })
-            .collect()
-    };
-    let mut r = combine(&scales, per_scale, params)?;
+    let per_scale = measure_values(points, nbrs, ratio, params, &scales);
+    let r = combine(&scales, per_scale, params)?;
+    finish(points, nbrs, ratio, r, params, segmentation)
+}
+
+/// The labelling stages after the thresholds (the Potts labelling on noisy clouds, the
+/// thinning, the surface stage) on the detector's result `r`.
+pub(crate) fn finish<'s>(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    ratio: f64,
+    mut r: SharpResult,
+    params: &SharpParams,
+    segmentation: impl FnOnce() -> Result<Cow<'s, PointSegmentation>>,
+) -> Result<SharpResult> {
     r.noise_ratio = Some(ratio);
     let auto = Regularize::noisy();
     let params = match (&params.regularize, params.auto_regularize) {
@@ -523,6 +462,95 @@ fn detect_core<'s>(
         r.surfaces = Some(report);
     }
     Ok(r)
+}
+
+/// Per scale, the measure of every point over its neighbourhood (steps 1 of the module
+/// documentation): the expensive pass, one gathering of the largest neighbourhood per point.
+/// `ratio` the measured noise ratio (the one-face test is off on noisy clouds).
+pub(crate) fn measure_values(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    ratio: f64,
+    params: &SharpParams,
+    scales: &[usize],
+) -> Vec<Vec<f64>> {
+    let kmax = scales.iter().copied().max().unwrap_or(1);
+    if matches!(
+        params.measure,
+        Measure::ProjectedDistance | Measure::SurfaceVariation
+    ) {
+        // Every scale from one gathering of the largest neighbourhood per point.
+        let ns = scales.len();
+        // The one-face test compares chord angles of 15°: on clouds whose noise is a sizeable
+        // fraction of the spacing (the regularised ones) it drops neighbours at random.
+        let face_normals = (params.one_face && ratio <= noise::NOISY_RATIO)
+            .then(|| face::face_normals(points, nbrs));
+        let test = face::SheetTest::default();
+        let mut flat = vec![0.0f64; points.len() * ns];
+        flat.par_chunks_mut(ns)
+            .enumerate()
+            .with_min_len(256)
+            .for_each_init(
+                || (Vec::new(), Vec::new(), vec![0usize; ns], Vec::new()),
+                |(coords, work, ends, cum): &mut Gather, (i, out)| {
+                    let p = points[i];
+                    coords.clear();
+                    coords.push(p);
+                    let row = nbrs.prefix(i, kmax);
+                    match &face_normals {
+                        Some(m) => {
+                            // The neighbours on the point's own sheet; scale s keeps those among
+                            // its scales[s] nearest.
+                            let mp = m[i];
+                            cum.clear();
+                            cum.push(1);
+                            for &j in row {
+                                let q = points[j as usize];
+                                if !test.other_sheet(p, mp, q, m[j as usize]) {
+                                    coords.push(q);
+                                }
+                                cum.push(coords.len());
+                            }
+                            for (e, &k) in ends.iter_mut().zip(scales) {
+                                *e = cum[k.min(row.len())];
+                            }
+                        }
+                        None => {
+                            coords.extend(row.iter().map(|&j| points[j as usize]));
+                            for (e, &k) in ends.iter_mut().zip(scales) {
+                                *e = k + 1;
+                            }
+                        }
+                    }
+                    measures::pca_measure_scales(
+                        coords,
+                        ends,
+                        params.measure,
+                        params.pca_weight,
+                        params.density_invariant,
+                        work,
+                        out,
+                    );
+                },
+            );
+        (0..ns)
+            .map(|s| flat.par_chunks(ns).map(|row| row[s]).collect())
+            .collect()
+    } else {
+        scales
+            .iter()
+            .map(|&k| {
+                measures::measure_at_scale(
+                    points,
+                    |i| nbrs.prefix(i, k),
+                    None,
+                    params.measure,
+                    params.pca_weight,
+                    params.density_invariant,
+                )
+            })
+            .collect()
+    }
 }
 
 /// The labelling stages of [`detect_points_with`] after the thresholds: from the per-point
@@ -630,11 +658,9 @@ fn combine(
     per_scale: Vec<Vec<f64>>,
     params: &SharpParams,
 ) -> Result<SharpResult> {
-    let n = per_scale.first().map_or(0, Vec::len);
-    let mut reports = Vec::with_capacity(scales.len());
     let mut thresholds = Vec::with_capacity(scales.len());
-    for (&s, values) in scales.iter().zip(&per_scale) {
-        let (t, tn) = match params.threshold {
+    for values in &per_scale {
+        thresholds.push(match params.threshold {
             ThresholdRule::Otsu => {
                 let o = otsu(values, &params.otsu)?;
                 (o.threshold, o.normalized)
@@ -648,16 +674,33 @@ fn combine(
                 let max = values.par_iter().copied().reduce(|| 0.0, f64::max);
                 (tn * max, tn)
             }
-        };
-        let detected = values.par_iter().filter(|&&v| v >= t).count();
-        reports.push(ScaleReport {
-            scale: s,
-            threshold: t,
-            normalized_threshold: tn,
-            detected,
         });
-        thresholds.push(t);
     }
+    Ok(apply_thresholds(scales, &per_scale, &thresholds))
+}
+
+/// Equations 4 and 5 and the sharpness min_s value_s / T_s from each scale's threshold
+/// (T_s, T_s normalised).
+pub(crate) fn apply_thresholds(
+    scales: &[usize],
+    per_scale: &[Vec<f64>],
+    thresholds: &[(f64, f64)],
+) -> SharpResult {
+    let n = per_scale.first().map_or(0, Vec::len);
+    let reports = scales
+        .iter()
+        .zip(per_scale)
+        .zip(thresholds)
+        .map(
+            |((&scale, values), &(threshold, normalized_threshold))| ScaleReport {
+                scale,
+                threshold,
+                normalized_threshold,
+                detected: values.par_iter().filter(|&&v| v >= threshold).count(),
+            },
+        )
+        .collect();
+    let thresholds: Vec<f64> = thresholds.iter().map(|t| t.0).collect();
     let sharpness: Vec<f64> = (0..n)
         .into_par_iter()
         .map(|i| {
@@ -686,12 +729,12 @@ fn combine(
                 .for_each(|(a, &x)| *a = *a && x >= t);
             acc
         });
-    Ok(SharpResult {
+    SharpResult {
         sharp,
         sharpness,
         scales: reports,
         noise_ratio: None,
         regularized: false,
         surfaces: None,
-    })
+    }
 }

@@ -3,4 +3,4 @@
 
 pub mod otsu;
 
-pub use otsu::{otsu, Otsu, OtsuParams};
+pub use otsu::{histogram, otsu, otsu_of_histogram, Otsu, OtsuParams};

@@ -112,24 +112,24 @@ pub fn otsu(values: &[f64], params: &OtsuParams) -> Result<Otsu> {
     } else {
         max
     };
-    let bins = params.bins;
+    let histogram = histogram(values, lo, hi, params.bins);
+    Ok(otsu_of_histogram(histogram, lo, hi, max))
+}
+
+/// The histogram of `values` in `bins` equal bins over [`lo`, `hi`] (values above `hi` in the
+/// last bin; all in the first when `hi` ≤ `lo`), as [`otsu`] counts it. Histograms of parts of
+/// a set of values over the same range add up to the set's: a cloud cut into tiles
+/// ([`crate::sharp::tiled`]) gets the same threshold as the whole.
+pub fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Vec<u64> {
+    let bins = bins.max(1);
     if hi <= lo {
-        return Ok(Otsu {
-            threshold: next_up(max),
-            normalized: 1.0,
-            range: (lo, hi),
-            between_variance: 0.0,
-            upper_count: 0,
-            histogram: {
-                let mut h = vec![0u64; bins];
-                h[0] = values.len() as u64;
-                h
-            },
-        });
+        let mut h = vec![0u64; bins];
+        h[0] = values.len() as u64;
+        return h;
     }
     let width = (hi - lo) / bins as f64;
     let bin_of = |v: f64| (((v - lo) / width) as usize).min(bins - 1);
-    let histogram = values
+    values
         .par_chunks(1 << 14)
         .map(|chunk| {
             let mut h = vec![0u64; bins];
@@ -144,7 +144,25 @@ pub fn otsu(values: &[f64], params: &OtsuParams) -> Result<Otsu> {
                 a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
                 a
             },
-        );
+        )
+}
+
+/// Otsu's threshold from the [`histogram`] over [`lo`, `hi`] of values whose largest is `max`
+/// (what [`otsu`] does once it has counted; `upper_count` is read from the bins).
+pub fn otsu_of_histogram(histogram: Vec<u64>, lo: f64, hi: f64, max: f64) -> Otsu {
+    let bins = histogram.len();
+    if hi <= lo || bins < 2 {
+        return Otsu {
+            threshold: next_up(max),
+            normalized: 1.0,
+            range: (lo, hi),
+            between_variance: 0.0,
+            upper_count: 0,
+            histogram,
+        };
+    }
+    let width = (hi - lo) / bins as f64;
+    let bin_of = |v: f64| (((v - lo) / width) as usize).min(bins - 1);
     let (t, between_variance) = otsu_bin(&histogram);
     // Class 1 starts at bin t + 1; its lower edge in value units.
     let normalized = (t + 1) as f64 / bins as f64;
@@ -155,15 +173,15 @@ pub fn otsu(values: &[f64], params: &OtsuParams) -> Result<Otsu> {
     } else {
         next_up(threshold)
     };
-    let upper_count = values.par_iter().filter(|&&v| v >= threshold).count();
-    Ok(Otsu {
+    let upper_count = histogram[(t + 1).min(bins)..].iter().sum::<u64>() as usize;
+    Otsu {
         threshold,
         normalized,
         range: (lo, hi),
         between_variance,
         upper_count,
         histogram,
-    })
+    }
 }
 
 /// The bin t maximising the between-class variance when class 0 is bins 0..=t (first maximum on

@@ -26,5 +26,6 @@ mod ring;
 mod segment;
 mod segment_points;
 mod sharp;
+mod sharp_tiled;
 mod spatial_knn;
 mod synth;
