@@ -123,13 +123,9 @@ def _run_job(job: Tuple[str, str, List[str], Optional[int], List[str]]) -> Dict[
     }
 
 
-def _result(fut: Any, job: Tuple[Any, ...]) -> Dict[str, Any]:
-    """A finished future's result; a worker that died (a crash, killed for memory) is reported
-    as that file's failure."""
-    try:
-        return fut.result()
-    except Exception as e:  # noqa: BLE001
-        return {"input": job[1], "output": job[2][0], "seconds": 0.0, "error": f"{job[1]}: the worker failed: {e!r}"}
+def _worker_failed(job: Tuple[Any, ...], e: BaseException) -> Dict[str, Any]:
+    """The result of a job whose worker died (a crash, killed for memory): that file's failure."""
+    return {"input": job[1], "output": job[2][0], "seconds": 0.0, "error": f"{job[1]}: the worker failed: {e!r}"}
 
 
 def _set_threads(n: Optional[int]) -> None:
@@ -150,27 +146,40 @@ def map_tasks(
     workers: int = 1,
     threads: Optional[int] = None,
     bar: Any = None,
+    recover: Any = None,
 ) -> List[Any]:
     """``[fn(j) for j in jobs]`` run as tasks: on the dask ``client``'s workers, on a local pool
     of ``workers`` fresh processes using ``threads`` threads each, or here when ``workers`` is
     1. ``fn`` is a module-level function (pickled by reference). Results in the order of
-    ``jobs``; the first task that raises raises here."""
+    ``jobs``. A task that raises raises here, unless ``recover(job, exception)`` gives its
+    result instead."""
     if not jobs:
         return []
-    if client is not None:
-        futures = client.map(fn, jobs, pure=False)
-        if bar is not None:
-            from distributed import as_completed
 
-            for _ in as_completed(futures):
-                bar.update(1)
-        return client.gather(futures)
+    def result(fut: Any, job: Any) -> Any:
+        try:
+            return fut.result()
+        except Exception as e:  # noqa: BLE001
+            if recover is None:
+                raise
+            return recover(job, e)
+
+    def tick() -> None:
+        if bar is not None:
+            bar.update(1)
+
+    if client is not None:
+        from distributed import as_completed
+
+        futures = client.map(fn, jobs, pure=False)
+        for _ in as_completed(futures):
+            tick()
+        return [result(f, j) for f, j in zip(futures, jobs)]
     if workers <= 1:
         out = []
         for j in jobs:
             out.append(fn(j))
-            if bar is not None:
-                bar.update(1)
+            tick()
         return out
     import concurrent.futures as cf
     import multiprocessing as mp
@@ -181,10 +190,9 @@ def map_tasks(
         max_workers=workers, mp_context=ctx, initializer=_set_threads, initargs=(threads,)
     ) as pool:
         futures = [pool.submit(fn, j) for j in jobs]
-        if bar is not None:
-            for _ in cf.as_completed(futures):
-                bar.update(1)
-        return [f.result() for f in futures]
+        for _ in cf.as_completed(futures):
+            tick()
+        return [result(f, j) for f, j in zip(futures, jobs)]
 
 
 def _progress(total: int, enabled: bool) -> Any:
@@ -260,42 +268,15 @@ def batch(
     jobs = [(task, p, _outputs(task, p, out), threads, options) for p in todo]
     bar = _progress(len(jobs), progress)
 
-    def record(r: Dict[str, Any]) -> None:
+    try:
+        results = map_tasks(_run_job, jobs, client, workers or 1, None, bar, recover=_worker_failed)
+    finally:
+        if bar is not None:
+            bar.close()
+    for r in results:
         if r.get("error") is None:
             report.done.append((r["input"], r["output"], r["seconds"]))
         else:
             report.failed.append((r["input"], r["error"]))
-        if bar is not None:
-            bar.update(1)
-
-    try:
-        if not jobs:
-            pass
-        elif client is not None:
-            from distributed import as_completed
-
-            futures = client.map(_run_job, jobs, pure=False)
-            of = {f.key: j for f, j in zip(futures, jobs)}
-            for fut in as_completed(futures):
-                record(_result(fut, of[fut.key]))
-        elif workers == 1:
-            for job in jobs:
-                record(_run_job(job))
-        else:
-            import concurrent.futures as cf
-            import multiprocessing as mp
-
-            # Fresh interpreters: a forked child would inherit the parent's thread pools.
-            ctx = mp.get_context("spawn")
-            with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-                of = {pool.submit(_run_job, j): j for j in jobs}
-                for fut in cf.as_completed(of):
-                    record(_result(fut, of[fut]))
-    finally:
-        if bar is not None:
-            bar.close()
-    order = {p: i for i, p in enumerate(inputs)}
-    report.done.sort(key=lambda d: order[d[0]])
-    report.failed.sort(key=lambda d: order[d[0]])
     report.seconds = time.perf_counter() - start
     return report
