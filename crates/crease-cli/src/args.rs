@@ -61,6 +61,9 @@ pub enum Command {
     Curvature(crate::commands::curvature::CurvatureArgs),
     /// Draw points, meshes and polylines into a PNG (four views by default).
     Render(RenderArgs),
+    /// An interactive 3D view in one self-contained HTML file (any browser, offline): turn,
+    /// zoom, colour by any attribute, toggle line layers, click a point for its surface.
+    View(crate::commands::view::ViewArgs),
     /// Estimate a normal per point (PCA, Delaunay 1-ring or mesh faces), optionally oriented.
     Normals(crate::commands::normals::NormalsArgs),
     /// Closed sharp feature lines of a point cloud (Demarsin 2007 graph pipeline).

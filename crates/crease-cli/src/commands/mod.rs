@@ -16,6 +16,7 @@ pub(crate) mod segment;
 pub(crate) mod sharp;
 mod synth;
 pub(crate) mod train;
+pub mod view;
 
 use std::path::Path;
 
@@ -37,6 +38,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         } => convert::run(g, &input, &output, ascii),
         Command::Synth(a) => synth::run(g, &a),
         Command::Render(a) => render::run(g, &a),
+        Command::View(a) => view::run(g, &a),
         Command::Curvature(a) => curvature::run(g, &a),
         Command::Demo { output, n } => demo::run(g, &output, n),
         Command::Normals(a) => normals::run(g, &a),

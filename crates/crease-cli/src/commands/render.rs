@@ -86,18 +86,26 @@ pub fn polylines_of(geom: &crease::io::Geometry, file_index: usize) -> Vec<Polyl
         color,
         label: label.map(String::from),
     };
-    let mut out: Vec<Polyline> = geom
-        .polylines
-        .iter()
-        .map(|l| to_polyline(l, default, None))
-        .collect();
-    let kind = geom.edge_attributes.get("curve_kind");
     let kinds: [(i64, [u8; 3], Option<&str>); 4] = [
         (0, [220, 30, 30], Some("sharp")),
         (1, [30, 90, 220], Some("smooth")),
         (2, [110, 110, 110], Some("boundary")),
         (-1, default, None),
     ];
+    // OBJ groups named as the curve network's (`sharp`, `smooth`, `boundary`) keep their colour.
+    let mut out: Vec<Polyline> = geom
+        .polylines
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let group = geom.polyline_groups.get(i).map(String::as_str);
+            match kinds.iter().find(|k| k.2.is_some() && k.2 == group) {
+                Some(&(_, color, label)) => to_polyline(l, color, label),
+                None => to_polyline(l, default, group.filter(|g| !g.is_empty())),
+            }
+        })
+        .collect();
+    let kind = geom.edge_attributes.get("curve_kind");
     for (code, color, label) in kinds {
         let edges: Vec<[u32; 2]> = geom
             .edges

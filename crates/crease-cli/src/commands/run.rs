@@ -14,6 +14,7 @@
 //! | `part.step` | the B-rep (`crease::brep::reconstruct_cloud` on the same analysis): a solid, or an open shell saying what it leaves out; when none can be built the summary says why | the same (`crease::brep::reconstruct_segmented_mesh` on the same segmentation) |
 //! | `summary.json` | counts, per-stage times, how often each shared piece was computed | the same |
 //! | `picture.png` | the points coloured by surface, the network on top | the mesh coloured by surface, the edges on top |
+//! | `report.html` | an interactive 3D view (`crease view`): the points with every label, the network's groups as layers, a click shows a point's surface | the mesh's faces with their surfaces, the edges |
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -26,6 +27,7 @@ use crease::fillets::Label;
 use crease::geometry::{names, Attribute, PointCloud, ScalarKind, TriMesh};
 use crease::io::Geometry;
 use crease::pipeline::{run_cloud as run_cloud_job, run_mesh as run_mesh_job};
+use crease::render::html::PageParams;
 use crease::render::{ColorBy, Polyline, RenderParams, Scene};
 use crease::segment::SegmentSurface;
 
@@ -72,6 +74,7 @@ pub fn run(g: &Global, a: &RunArgs) -> anyhow::Result<()> {
         "summary.json",
         "picture.png",
         "part.step",
+        "report.html",
     ] {
         crate::ui::ensure_not_input(&a.output.join(name), &[&a.input])?;
     }
@@ -175,20 +178,21 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     net.polylines = network.polylines.clone();
     net.polyline_groups = network.groups().iter().map(|g| g.to_string()).collect();
     super::save(g, &a.output.join("network.obj"), &net, false, &[&a.input])?;
-    write_surfaces(&a.output, &run.surfaces, &run.groups, run.mean_edge)?;
+    let surfaces = write_surfaces(&a.output, &run.surfaces, &run.groups, run.mean_edge)?;
     let brep = write_brep(a, &name, points, &run.brep)?;
 
     let sharp_lines = network.count(names::SHARP);
     let smooth_lines = network.count(names::SMOOTH);
+    let lines: Vec<Polyline> = network
+        .polylines
+        .iter()
+        .zip(network.groups())
+        .map(|(l, group)| picture_line(l, &network.vertices, group))
+        .collect();
     if !a.no_picture {
-        let lines = network
-            .polylines
-            .iter()
-            .zip(network.groups())
-            .map(|(l, group)| picture_line(l, &network.vertices, group))
-            .collect();
-        picture(a, &labels, None, lines, run.surfaces.len())?;
+        picture(a, &labels, None, lines.clone(), run.surfaces.len())?;
     }
+    report(a, &labels, lines, surfaces)?;
     let assigned = run.surface.iter().filter(|&&s| s >= 0).count();
     Ok(serde_json::json!({
         "kind": "cloud",
@@ -292,15 +296,16 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
     net.polylines = lines.clone();
     net.polyline_groups = vec![names::SHARP.to_string(); lines.len()];
     super::save(g, &a.output.join("network.obj"), &net, false, &[&a.input])?;
-    write_surfaces(&a.output, &seg.surfaces, &seg.groups, seg.mean_edge)?;
+    let surfaces = write_surfaces(&a.output, &seg.surfaces, &seg.groups, seg.mean_edge)?;
+    let drawn: Vec<Polyline> = lines
+        .iter()
+        .map(|l| picture_line(l, &out.points.positions, names::SHARP))
+        .collect();
     if !a.no_picture {
-        let drawn = lines
-            .iter()
-            .map(|l| picture_line(l, &out.points.positions, names::SHARP))
-            .collect();
         let mesh = out.clone().into_mesh().context("labelled mesh")?;
-        picture(a, &out, Some(&mesh), drawn, seg.surfaces.len())?;
+        picture(a, &out, Some(&mesh), drawn.clone(), seg.surfaces.len())?;
     }
+    report(a, &out, drawn, surfaces)?;
     let assigned = seg.face_surface.iter().filter(|&&s| s >= 0).count();
     Ok(serde_json::json!({
         "kind": "mesh",
@@ -320,20 +325,43 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
     }))
 }
 
-/// `surfaces.json`: the surfaces with their parameters (as `crease segment --primitives`).
+/// `surfaces.json`: the surfaces with their parameters (as `crease segment --primitives`);
+/// returns what it wrote.
 fn write_surfaces(
     dir: &Path,
     surfaces: &[SegmentSurface],
     groups: &[crease::segment::recognize::Group],
     mean_edge: f64,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<serde_json::Value> {
     let doc = serde_json::json!({
         "surface_type_codes": {"plane": 0, "cylinder": 1, "cone": 2, "sphere": 3, "torus": 4, "unassigned": 255},
         "mean_edge": mean_edge,
         "surfaces": surfaces,
         "groups": groups,
     });
-    write_json(&dir.join("surfaces.json"), &doc)
+    write_json(&dir.join("surfaces.json"), &doc)?;
+    Ok(doc)
+}
+
+/// `report.html`: the interactive view of the labelled input, its lines and its surfaces.
+fn report(
+    a: &RunArgs,
+    labels: &Geometry,
+    lines: Vec<Polyline>,
+    surfaces: serde_json::Value,
+) -> anyhow::Result<()> {
+    let params = PageParams {
+        title: a
+            .input
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        surfaces: Some(surfaces),
+        ..Default::default()
+    };
+    super::view::write_view(&a.output.join("report.html"), labels, lines, &params)
+        .context("cannot write report.html")?;
+    Ok(())
 }
 
 /// Writes pretty JSON to `path`, replaced atomically.

@@ -16,3 +16,4 @@ mod normals_cli;
 mod reconstruct_cli;
 mod segment_cli;
 mod sharp_cli;
+mod view_cli;

@@ -133,6 +133,9 @@ struct Parser {
     normals: Vec<[f64; 3]>,
     faces: Vec<[u32; 3]>,
     polylines: Vec<Vec<u32>>,
+    /// The group (`g`) each polyline was read in, and the current one.
+    polyline_groups: Vec<String>,
+    group: String,
     triangulated: usize,
     /// Normal index per vertex from the face corners (`NONE` if none yet).
     vertex_normal: Vec<u32>,
@@ -287,6 +290,12 @@ impl Parser {
                 }
                 self.polylines
                     .push(self.corners.iter().map(|c| c.0).collect());
+                self.polyline_groups.push(self.group.clone());
+            }
+            // Groups name the polylines that follow (crease writes its curve network's kinds so:
+            // `sharp`, `smooth`, `boundary`); other uses of groups are not kept.
+            b"g" => {
+                self.group = toks.map(lossy).collect::<Vec<_>>().join(" ");
             }
             _ => {
                 let k = String::from_utf8_lossy(key);
@@ -491,7 +500,6 @@ impl Parser {
                 "vt" => " (texture coordinates)",
                 "p" => " (points)",
                 "o" => " (object names)",
-                "g" => " (groups)",
                 "s" => " (smoothing groups)",
                 "usemtl" | "mtllib" => " (materials)",
                 _ => "",
@@ -500,10 +508,16 @@ impl Parser {
                 .notes
                 .push(format!("ignored {n} '{k}' statement(s){what}"));
         }
+        let named = self.polyline_groups.iter().any(|g| !g.is_empty());
         let geom = Geometry {
             points: cloud,
             faces: self.faces,
             polylines: self.polylines,
+            polyline_groups: if named {
+                self.polyline_groups
+            } else {
+                Vec::new()
+            },
             ..Default::default()
         };
         Ok((geom, report))

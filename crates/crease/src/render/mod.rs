@@ -51,6 +51,7 @@
 mod camera;
 pub mod colormap;
 pub mod font;
+pub mod html;
 mod legend;
 mod raster;
 mod style;

@@ -961,3 +961,73 @@ fn demo_real_data() {
         eprintln!("wrote {}", out.display());
     }
 }
+
+/// The HTML view (`crease::render::html`): a 1M-point cloud with `crease run`'s six labels fits
+/// in 40 MB; above `max_points` an even subsample is embedded and the page says how many of how
+/// many; the page holds no reference to the network.
+#[test]
+fn html_view_size_and_subsample() {
+    use crease::render::html::{page, PageParams};
+    use crease::render::Scene;
+    use crease::{Attribute, PointCloud};
+    let n = 1_000_000;
+    let mut cloud = PointCloud::from_positions(
+        (0..n)
+            .map(|i| {
+                let t = i as f64 * 0.618_033_988_75;
+                [t.fract(), (t * 7.0).fract(), (i % 1000) as f64 * 1e-3]
+            })
+            .collect(),
+    );
+    cloud
+        .set_attribute(Attribute::flag("sharp", (0..n).map(|i| i % 13 == 0)))
+        .expect("sharp");
+    cloud
+        .set_attribute(Attribute::float(
+            "sharpness",
+            (0..n).map(|i| (i % 97) as f64 / 97.0).collect::<Vec<f64>>(),
+        ))
+        .expect("sharpness");
+    cloud
+        .set_attribute(Attribute::int(
+            "surface",
+            (0..n).map(|i| (i % 300) as i64 - 1),
+        ))
+        .expect("surface");
+    for name in ["surface_type", "fillet_label"] {
+        let mut a = Attribute::int(name, (0..n).map(|i| (i % 5) as i64));
+        a.kind = crease::geometry::ScalarKind::U8;
+        cloud.set_attribute(a).expect("labels");
+    }
+    cloud
+        .set_attribute(Attribute::flag("smooth_edge", (0..n).map(|i| i % 17 == 0)))
+        .expect("smooth_edge");
+    let scene = Scene {
+        points: Some(&cloud),
+        mesh: None,
+        polylines: Vec::new(),
+    };
+    let html = page(&scene, &PageParams::default()).expect("page");
+    assert!(
+        html.len() < 40_000_000,
+        "{} bytes for 1M points",
+        html.len()
+    );
+    assert!(html.contains("\"points\":1000000,") && html.contains("\"total_points\":1000000"));
+    assert!(!html.contains("src=\"http") && !html.contains("href=\"http"));
+    let small = page(
+        &scene,
+        &PageParams {
+            max_points: 250_000,
+            ..Default::default()
+        },
+    )
+    .expect("page");
+    assert!(
+        small.contains("\"points\":250000,"),
+        "an even subsample of 250,000"
+    );
+    assert!(small.len() * 3 < html.len());
+    let empty = Scene::default();
+    assert!(page(&empty, &PageParams::default()).is_err());
+}
