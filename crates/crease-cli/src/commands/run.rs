@@ -27,7 +27,7 @@ use crease::fillets::Label;
 use crease::geometry::{names, Attribute, PointCloud, ScalarKind, TriMesh};
 use crease::io::Geometry;
 use crease::pipeline::{run_cloud as run_cloud_job, run_mesh as run_mesh_job};
-use crease::render::html::PageParams;
+use crease::render::html::{Overlay, PageParams};
 use crease::render::{ColorBy, Polyline, RenderParams, Scene};
 use crease::segment::SegmentSurface;
 
@@ -192,7 +192,7 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     if !a.no_picture {
         picture(a, &labels, None, lines.clone(), run.surfaces.len())?;
     }
-    report(a, &labels, lines, surfaces)?;
+    report(a, &labels, lines, surfaces, &run.brep)?;
     let assigned = run.surface.iter().filter(|&&s| s >= 0).count();
     Ok(serde_json::json!({
         "kind": "cloud",
@@ -305,7 +305,7 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
         let mesh = out.clone().into_mesh().context("labelled mesh")?;
         picture(a, &out, Some(&mesh), drawn.clone(), seg.surfaces.len())?;
     }
-    report(a, &out, drawn, surfaces)?;
+    report(a, &out, drawn, surfaces, &run.brep)?;
     let assigned = seg.face_surface.iter().filter(|&&s| s >= 0).count();
     Ok(serde_json::json!({
         "kind": "mesh",
@@ -343,14 +343,32 @@ fn write_surfaces(
     Ok(doc)
 }
 
-/// `report.html`: the interactive view of the labelled input, its lines and its surfaces.
+/// `report.html`: the interactive view of the labelled input, its lines, its surfaces and the
+/// B-rep's faces (a layer, off when the page opens).
 fn report(
     a: &RunArgs,
     labels: &Geometry,
     lines: Vec<Polyline>,
     surfaces: serde_json::Value,
+    brep: &crease::Result<crease::brep::Reconstruction>,
 ) -> anyhow::Result<()> {
+    let overlays = match brep.as_ref().map(|r| r.tessellate()) {
+        Ok(Ok(mesh)) => vec![Overlay {
+            name: "B-rep".into(),
+            mesh,
+            visible: false,
+        }],
+        Ok(Err(e)) => {
+            tracing::warn!(
+                "{}: the B-rep could not be tessellated for the report: {e}",
+                a.input.display()
+            );
+            Vec::new()
+        }
+        Err(_) => Vec::new(),
+    };
     let params = PageParams {
+        overlays,
         title: a
             .input
             .file_name()

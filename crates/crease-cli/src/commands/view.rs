@@ -82,6 +82,7 @@ pub fn run(g: &Global, a: &ViewArgs) -> anyhow::Result<()> {
         color_by: a.color_by.clone(),
         surfaces,
         max_points: a.max_points,
+        overlays: Vec::new(),
     };
     let n = geom.points.len();
     let bytes = write_view(&a.output, &geom, polylines, &params)

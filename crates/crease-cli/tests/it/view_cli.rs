@@ -1,7 +1,8 @@
 //! `crease view` and `crease run`'s report.html, rendered by a real browser: Chromium headless
 //! with WebGL on SwiftShader (Debian's `chromium`, installed by `.ci/run`). Screenshots are
 //! checked on their pixels (geometry drawn, the sharp lines' colour present, a layer toggled off
-//! removes it, another colouring changes the picture), a click shows the surface under it, and
+//! removes it, the B-rep's faces drawn when their layer is on, another colouring changes the
+//! picture), a click shows the surface under it, and
 //! the browser's network log shows no request from the page. Without Chromium the tests skip,
 //! except under `CI=true`, where they fail.
 
@@ -186,6 +187,14 @@ fn the_report_draws_points_and_lines_and_its_layers_toggle() {
     assert!(
         drawn_lines * 5 < drawn,
         "points off: {drawn_lines} of {drawn} pixels left"
+    );
+
+    // The B-rep's faces, a layer off when the page opens, drawn when switched on.
+    let brep = screenshot(&exe, &page, "#points=off&layer-B-rep=on");
+    let drawn_brep = count(&brep, |p| !near(p, BACKGROUND, 6));
+    assert!(
+        drawn_brep > 5 * drawn_lines && drawn_brep > 60_000,
+        "B-rep layer on: {drawn_brep} pixels, lines alone {drawn_lines}"
     );
 
     let by_sharpness = screenshot(&exe, &page, "#color=sharpness");

@@ -20,14 +20,16 @@ const typed = (id, type) => {
 const n = meta.points;
 const ext = [0, 1, 2].map((a) => meta.max[a] - meta.min[a]);
 const diag = Math.hypot(...ext) || 1;
-const pos = new Float32Array(3 * n);
-if (n > 0) {
-  const q = typed(meta.positions, 'u16');
-  for (let i = 0; i < 3 * n; i++) {
+// Positions come as u16 per axis over the bounding box; the scene is centred on the box.
+const dequantise = (q) => {
+  const p = new Float32Array(q.length);
+  for (let i = 0; i < q.length; i++) {
     const a = i % 3;
-    pos[i] = meta.min[a] + (q[i] / 65535) * ext[a] - meta.centre[a];
+    p[i] = meta.min[a] + (q[i] / 65535) * ext[a] - meta.centre[a];
   }
-}
+  return p;
+};
+const pos = n > 0 ? dequantise(typed(meta.positions, 'u16')) : new Float32Array(0);
 const pointAttrs = (meta.attributes || []).map((a) => ({...a, values: typed(a.block, a.type)}));
 const faceAttrs = (meta.face_attributes || []).map((a) => ({...a, values: typed(a.block, a.type)}));
 const rgb = meta.colors ? bytes(meta.colors) : null;
@@ -46,11 +48,18 @@ renderer.setClearColor(0x16161d, 1);
 document.body.appendChild(renderer.domElement);
 const scene = new THREE.Scene();
 const camera = new THREE.PerspectiveCamera(35, innerWidth / innerHeight, diag / 1000, diag * 100);
-camera.up.set(0, 0, 1);
-const home = new THREE.Vector3(1, -1.25, 0.9).normalize().multiplyScalar(diag * 1.55);
+// The first view: a scan in its scanner's frame (the origin outside the data, as a Kinect's or a
+// RealSense's) is seen from the scanner; a part, from the isometric direction with Z up.
+const origin = new THREE.Vector3(...meta.centre).negate();
+const inside = [0, 1, 2].every((a) => meta.min[a] <= 0 && meta.max[a] >= 0);
+const dir = !inside && origin.length() > 0 ? origin.clone().normalize() : new THREE.Vector3(1, -1.25, 0.9).normalize();
+if (Math.abs(dir.z) > 0.9) camera.up.set(0, -1, 0); else camera.up.set(0, 0, 1);
+const home = dir.clone().multiplyScalar(diag * 1.55);
 camera.position.copy(home);
-scene.add(new THREE.AmbientLight(0xffffff, 0.55));
-const headlight = new THREE.DirectionalLight(0xffffff, 0.9);
+// Faces facing the camera keep about their colour, grazing ones darken (three.js' lights are in
+// physical units: a Lambert surface lit with intensity I reflects colour × I / π... × π).
+scene.add(new THREE.AmbientLight(0xffffff, 0.6));
+const headlight = new THREE.DirectionalLight(0xffffff, 2.2);
 camera.add(headlight);
 scene.add(camera);
 
@@ -74,8 +83,15 @@ if (faces) {
   const g = new THREE.BufferGeometry();
   g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
   g.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(3 * n), 3, true));
-  const size = n < 50000 ? 4 : n < 400000 ? 3 : 2;
-  cloud = new THREE.Points(g, new THREE.PointsMaterial({size, sizeAttenuation: false, vertexColors: true}));
+  // Squares 2.5 mean neighbour distances wide in the scene's units (so they shrink with
+  // distance): a randomly sampled surface looks closed and hides what is behind it. three.js
+  // scales an attenuated size by half the viewport height over the depth, without the field of
+  // view: hence the division by tan(fov / 2). Without a spacing, a few pixels.
+  const material = meta.spacing > 0
+    ? new THREE.PointsMaterial({size: (2.5 * meta.spacing) / Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)),
+      sizeAttenuation: true, vertexColors: true})
+    : new THREE.PointsMaterial({size: n < 50000 ? 4 : n < 400000 ? 3 : 2, sizeAttenuation: false, vertexColors: true});
+  cloud = new THREE.Points(g, material);
   scene.add(cloud);
 }
 const layers = (meta.layers || []).map((l) => {
@@ -86,6 +102,28 @@ const layers = (meta.layers || []).map((l) => {
   obj.renderOrder = 1;
   scene.add(obj);
   return {...l, obj};
+});
+
+// Further meshes (the B-rep's faces): per-face colours by surface type, each a layer.
+function faceMesh(p, f) {
+  const m = f.length / 3;
+  const q = new Float32Array(9 * m);
+  for (let t = 0; t < m; t++)
+    for (let k = 0; k < 3; k++) {
+      const v = f[3 * t + k];
+      for (let a = 0; a < 3; a++) q[9 * t + 3 * k + a] = p[3 * v + a];
+    }
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(q, 3));
+  g.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(9 * m), 3, true));
+  g.computeVertexNormals();
+  return new THREE.Mesh(g, new THREE.MeshLambertMaterial({vertexColors: true, side: THREE.DoubleSide}));
+}
+const overlays = (meta.overlays || []).map((o) => {
+  const obj = faceMesh(dequantise(typed(o.positions, 'u16')), typed(o.faces, 'u32'));
+  const attrs = o.face_attributes.map((a) => ({...a, values: typed(a.block, a.type)}));
+  scene.add(obj);
+  return {...o, obj, attrs};
 });
 
 const controls = new OrbitControls(camera, renderer.domElement);
@@ -207,14 +245,19 @@ if (mesh) toggle('faces', `faces (${(faces.length / 3).toLocaleString()})`, mesh
 if (cloud) toggle('points', `points (${n.toLocaleString()})`, cloud, opts.get('points') !== 'off');
 for (const l of layers)
   toggle(`layer-${l.name}`, `${swatch(l.color)}${esc(l.name)} (${l.polylines})`, l.obj, opts.get(`layer-${l.name}`) !== 'off');
+for (const o of overlays)
+  toggle(`layer-${o.name}`, `${esc(o.name)} (${o.face_count.toLocaleString()} triangles)`, o.obj,
+    opts.get(`layer-${o.name}`) ? opts.get(`layer-${o.name}`) !== 'off' : o.visible);
 const reset = document.createElement('button');
 reset.textContent = 'reset view';
 reset.addEventListener('click', () => { camera.position.copy(home); controls.target.set(0, 0, 0); controls.update(); render(); });
 controlsDiv.appendChild(reset);
 document.getElementById('color').addEventListener('change', (e) => colourBy(e.target.value));
-if (meta.total_points > meta.points)
-  document.getElementById('note').textContent =
-    `showing ${meta.points.toLocaleString()} of ${meta.total_points.toLocaleString()} points (an even subsample)`;
+document.getElementById('note').textContent = [
+  ...(meta.total_points > meta.points
+    ? [`showing ${meta.points.toLocaleString()} of ${meta.total_points.toLocaleString()} points (an even subsample)`] : []),
+  ...(meta.left_out || []),
+].join('; ');
 
 // --- picking --------------------------------------------------------------------------------
 const raycaster = new THREE.Raycaster();
@@ -247,6 +290,14 @@ function pick(x, y) {
   const perPixel = (2 * depth * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2))) / r.height;
   raycaster.params.Points.threshold = 5 * perPixel;
   const info = document.getElementById('info');
+  const shown = overlays.filter((o) => o.obj.visible);
+  const over = shown.length ? raycaster.intersectObjects(shown.map((o) => o.obj))[0] : undefined;
+  if (over) {
+    const o = shown.find((x) => x.obj === over.object);
+    info.textContent = describe(`${o.name}: triangle`, over.faceIndex, o.attrs);
+    info.style.display = 'block';
+    return;
+  }
   const target = mesh && mesh.visible ? mesh : cloud && cloud.visible ? cloud : null;
   const hit = target ? raycaster.intersectObject(target)[0] : undefined;
   if (!hit) { info.style.display = 'none'; return; }
@@ -261,6 +312,15 @@ renderer.domElement.addEventListener('pointerup', (e) => {
   down = null;
 });
 
+for (const o of overlays) {
+  const type = o.attrs.find((a) => a.name === 'surface_type');
+  const per = new Uint8Array(3 * o.face_count);
+  colourise(type || null, per);
+  const c = o.obj.geometry.getAttribute('color');
+  for (let f = 0; f < o.face_count; f++)
+    for (let k = 0; k < 3; k++) c.array.set(per.subarray(3 * f, 3 * f + 3), 9 * f + 3 * k);
+  c.needsUpdate = true;
+}
 colourBy(initial);
 render();
 if (opts.get('click')) {

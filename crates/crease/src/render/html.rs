@@ -22,6 +22,7 @@ use base64::Engine;
 use crate::geometry::{Aabb, Attribute, Point3, ScalarKind};
 use crate::render::{Polyline, Scene};
 use crate::spatial::morton_order;
+use crate::spatial::spacing::average_spacing;
 use crate::{Error, Result};
 
 /// three.js r170 and OrbitControls as one classic script (`scripts/vendor-three.py`).
@@ -50,6 +51,20 @@ pub struct PageParams {
     pub surfaces: Option<serde_json::Value>,
     /// Above this many points, an even subsample of this size is embedded (default 2,000,000).
     pub max_points: usize,
+    /// Further meshes shown as layers of their own, coloured by their faces' `surface_type`
+    /// (`crease run`'s report: the B-rep's faces, tessellated).
+    pub overlays: Vec<Overlay>,
+}
+
+/// A mesh shown as a layer of its own (see [`PageParams::overlays`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Overlay {
+    /// The layer's name.
+    pub name: String,
+    /// The triangles, with face attributes (shown when clicked).
+    pub mesh: crate::geometry::TriMesh,
+    /// Shown when the page opens.
+    pub visible: bool,
 }
 
 impl Default for PageParams {
@@ -59,9 +74,14 @@ impl Default for PageParams {
             color_by: None,
             surfaces: None,
             max_points: 2_000_000,
+            overlays: Vec::new(),
         }
     }
 }
+
+/// Overlays with more triangles are left out (the page says so): a 1M-point view stays under
+/// 40 MB with one of this size (12 bytes per triangle, 6 per vertex, 2 per attribute, base64).
+pub const MAX_OVERLAY_TRIANGLES: usize = 600_000;
 
 /// Attributes that are not worth their bytes in a view (normals: directions, not values).
 const SKIPPED: [&str; 3] = ["nx", "ny", "nz"];
@@ -241,6 +261,14 @@ pub fn page(scene: &Scene<'_>, params: &PageParams) -> Result<String> {
         meta["positions"] =
             serde_json::json!(blocks.add(&quantised(positions, rows.as_deref(), &b)));
     }
+    if scene.mesh.is_none() && total > 1 {
+        // Points are drawn as squares about this wide, so that a sampled surface looks closed.
+        let shown_points: Vec<Point3> = match &rows {
+            Some(r) => r.iter().map(|&i| positions[i as usize]).collect(),
+            None => positions.to_vec(),
+        };
+        meta["spacing"] = serde_json::json!(average_spacing(&shown_points));
+    }
     if let Some(c) = cloud {
         let attrs: Vec<serde_json::Value> = c
             .attributes
@@ -275,6 +303,49 @@ pub fn page(scene: &Scene<'_>, params: &PageParams) -> Result<String> {
         meta["face_attributes"] = serde_json::json!(attrs);
     }
     meta["layers"] = serde_json::json!(layers(&scene.polylines, centre, &mut blocks));
+    let mut left_out = Vec::new();
+    let overlays: Vec<serde_json::Value> = params
+        .overlays
+        .iter()
+        .filter(|o| {
+            let fits = o.mesh.faces.len() <= MAX_OVERLAY_TRIANGLES;
+            if !fits {
+                left_out.push(format!(
+                    "{} not shown: {} triangles (more than {MAX_OVERLAY_TRIANGLES})",
+                    o.name,
+                    o.mesh.faces.len()
+                ));
+            }
+            fits
+        })
+        .map(|o| {
+            let pos = quantised(&o.mesh.vertices.positions, None, &b);
+            let faces: Vec<u8> = o
+                .mesh
+                .faces
+                .iter()
+                .flatten()
+                .flat_map(|i| i.to_le_bytes())
+                .collect();
+            let attrs: Vec<serde_json::Value> = o
+                .mesh
+                .face_attributes
+                .iter()
+                .filter(|a| a.values.len() == o.mesh.faces.len())
+                .map(|a| blocks.attribute(a, None))
+                .collect();
+            serde_json::json!({
+                "name": o.name,
+                "visible": o.visible,
+                "positions": blocks.add(&pos),
+                "faces": blocks.add(&faces),
+                "face_count": o.mesh.faces.len(),
+                "face_attributes": attrs,
+            })
+        })
+        .collect();
+    meta["overlays"] = serde_json::json!(overlays);
+    meta["left_out"] = serde_json::json!(left_out);
     let meta = serde_json::to_string(&meta)
         .map_err(|e| Error::InvalidInput(format!("the view's description: {e}")))?
         // JSON inside <script>: no "</" can close the element early.

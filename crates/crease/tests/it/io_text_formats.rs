@@ -154,7 +154,9 @@ fn obj_all_index_forms_negative_indices_and_polygons() {
     assert_eq!(g.polylines, vec![vec![0, 1, 4], vec![2, 3]]);
     // Vertex 5 (index 4) is used by no face, so no per-vertex normal for every vertex.
     assert_eq!(g.points.normals, None);
-    for kind in ["'vt'", "'mtllib'", "'usemtl'", "'o'", "'g'", "'s'", "'p'"] {
+    // Groups name the polylines read in them (the curve network's `sharp`, `smooth`, ...).
+    assert_eq!(g.polyline_groups, vec!["group1", "group1"]);
+    for kind in ["'vt'", "'mtllib'", "'usemtl'", "'o'", "'s'", "'p'"] {
         assert_eq!(
             report.notes.iter().filter(|n| n.contains(kind)).count(),
             1,
@@ -162,7 +164,7 @@ fn obj_all_index_forms_negative_indices_and_polygons() {
             report.notes
         );
     }
-    assert!(report.notes.iter().any(|n| n.contains("ignored 2 'g'")));
+    assert!(!report.notes.iter().any(|n| n.contains("'g'")));
     assert!(report.notes.iter().any(|n| n.contains("ignored 4 'vt'")));
 }
 
