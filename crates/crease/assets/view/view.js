@@ -10,8 +10,15 @@ const bytes = (id) => {
   for (let i = 0; i < bin.length; i++) out[i] = bin.charCodeAt(i);
   return out;
 };
-const typed = (id, type) => {
+const typed = (id, type, lo = 0, hi = 0) => {
   const b = bytes(id);
+  if (type === 'q16') {
+    // Floats quantised over [lo, hi]; 65535 marks a value that was not finite.
+    const q = new Uint16Array(b.buffer, b.byteOffset, b.byteLength / 2);
+    const out = new Float32Array(q.length);
+    for (let i = 0; i < q.length; i++) out[i] = q[i] === 65535 ? NaN : lo + (q[i] / 65534) * (hi - lo);
+    return out;
+  }
   const T = {u8: Uint8Array, i16: Int16Array, i32: Int32Array, f32: Float32Array, u16: Uint16Array, u32: Uint32Array}[type];
   return new T(b.buffer, b.byteOffset, b.byteLength / T.BYTES_PER_ELEMENT);
 };
@@ -30,8 +37,9 @@ const dequantise = (q) => {
   return p;
 };
 const pos = n > 0 ? dequantise(typed(meta.positions, 'u16')) : new Float32Array(0);
-const pointAttrs = (meta.attributes || []).map((a) => ({...a, values: typed(a.block, a.type)}));
-const faceAttrs = (meta.face_attributes || []).map((a) => ({...a, values: typed(a.block, a.type)}));
+const attrValues = (a) => ({...a, values: typed(a.block, a.type, a.lo, a.hi)});
+const pointAttrs = (meta.attributes || []).map(attrValues);
+const faceAttrs = (meta.face_attributes || []).map(attrValues);
 const rgb = meta.colors ? bytes(meta.colors) : null;
 const faces = meta.faces ? typed(meta.faces, 'u32') : null;
 const surfaces = new Map();
@@ -121,7 +129,7 @@ function faceMesh(p, f) {
 }
 const overlays = (meta.overlays || []).map((o) => {
   const obj = faceMesh(dequantise(typed(o.positions, 'u16')), typed(o.faces, 'u32'));
-  const attrs = o.face_attributes.map((a) => ({...a, values: typed(a.block, a.type)}));
+  const attrs = o.face_attributes.map(attrValues);
   scene.add(obj);
   return {...o, obj, attrs};
 });
