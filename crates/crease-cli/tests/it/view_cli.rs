@@ -230,6 +230,22 @@ fn a_click_shows_the_surface_under_it() {
         "the surface's parameters: {text}"
     );
     assert!(text.contains("RMS: "), "{text}");
+
+    // Above --max-points, an even subsample, said on the page.
+    let labels = page.with_file_name("labels.ply");
+    let small = page.with_file_name("small.html");
+    crease()
+        .args(["view", "-q", "--max-points", "5000"])
+        .arg(&labels)
+        .arg("-o")
+        .arg(&small)
+        .assert()
+        .success();
+    let d = dom(&exe, &small, "", &[]);
+    assert!(
+        d.contains("showing 5,000 of 30,000 points (an even subsample)"),
+        "the note on the page"
+    );
 }
 
 #[test]
