@@ -71,21 +71,24 @@ const headlight = new THREE.DirectionalLight(0xffffff, 2.2);
 camera.add(headlight);
 scene.add(camera);
 
-let cloud = null, mesh = null;
-if (faces) {
-  // One vertex per face corner, so that each face has its own colour and a flat normal.
-  const m = faces.length / 3;
-  const p = new Float32Array(9 * m);
-  for (let f = 0; f < m; f++)
+// A mesh with one vertex per face corner, so that each face has its own colour and a flat normal.
+function faceMesh(p, f) {
+  const m = f.length / 3;
+  const q = new Float32Array(9 * m);
+  for (let t = 0; t < m; t++)
     for (let k = 0; k < 3; k++) {
-      const v = faces[3 * f + k];
-      for (let a = 0; a < 3; a++) p[9 * f + 3 * k + a] = pos[3 * v + a];
+      const v = f[3 * t + k];
+      for (let a = 0; a < 3; a++) q[9 * t + 3 * k + a] = p[3 * v + a];
     }
   const g = new THREE.BufferGeometry();
-  g.setAttribute('position', new THREE.BufferAttribute(p, 3));
+  g.setAttribute('position', new THREE.BufferAttribute(q, 3));
   g.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(9 * m), 3, true));
   g.computeVertexNormals();
-  mesh = new THREE.Mesh(g, new THREE.MeshLambertMaterial({vertexColors: true, side: THREE.DoubleSide}));
+  return new THREE.Mesh(g, new THREE.MeshLambertMaterial({vertexColors: true, side: THREE.DoubleSide}));
+}
+let cloud = null, mesh = null;
+if (faces) {
+  mesh = faceMesh(pos, faces);
   scene.add(mesh);
 } else if (n > 0) {
   const g = new THREE.BufferGeometry();
@@ -113,20 +116,6 @@ const layers = (meta.layers || []).map((l) => {
 });
 
 // Further meshes (the B-rep's faces): per-face colours by surface type, each a layer.
-function faceMesh(p, f) {
-  const m = f.length / 3;
-  const q = new Float32Array(9 * m);
-  for (let t = 0; t < m; t++)
-    for (let k = 0; k < 3; k++) {
-      const v = f[3 * t + k];
-      for (let a = 0; a < 3; a++) q[9 * t + 3 * k + a] = p[3 * v + a];
-    }
-  const g = new THREE.BufferGeometry();
-  g.setAttribute('position', new THREE.BufferAttribute(q, 3));
-  g.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(9 * m), 3, true));
-  g.computeVertexNormals();
-  return new THREE.Mesh(g, new THREE.MeshLambertMaterial({vertexColors: true, side: THREE.DoubleSide}));
-}
 const overlays = (meta.overlays || []).map((o) => {
   const obj = faceMesh(dequantise(typed(o.positions, 'u16')), typed(o.faces, 'u32'));
   const attrs = o.face_attributes.map(attrValues);
