@@ -753,15 +753,18 @@ def network(
     tau: Optional[Sequence[float]] = None,
     coarse_retry: bool = False,
     boundary: bool = True,
+    lines_from: str = "surfaces",
 ) -> Curves:
     """The whole curve network of a cloud, as ``crease network``: sharp and fillet polylines,
     ``groups`` saying which (``"sharp"`` / ``"smooth"`` / ``"boundary"``, the CLI's OBJ
-    groups), and the per-point labels of :func:`fillets`."""
+    groups), and the per-point labels of :func:`fillets`. ``lines_from="surfaces"`` (default)
+    anchors the lines on the fitted surfaces (the B-rep's edges; Demarsin's lines where no
+    surface explains the points), ``"points"`` gives Demarsin's graph lines only."""
     return _fillets(
         points, True, thresholds, k=k, region_angle=region_angle, spur_length=spur_length,
         curvature_k=curvature_k, smoothing=smoothing, median=median, trim=trim, bins=bins,
         one_run=one_run, max_thresholds=max_thresholds, tau=tau, coarse_retry=coarse_retry,
-        boundary=boundary,
+        boundary=boundary, lines_from=lines_from,
     )
 
 

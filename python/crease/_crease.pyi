@@ -82,6 +82,7 @@ def fillets(
     tau: Optional[List[float]] = ...,
     coarse_retry: bool = ...,
     boundary: bool = ...,
+    lines_from: str = ...,
 ) -> Dict[str, Any]: ...
 def edges(
     vertices: npt.NDArray[np.float64],

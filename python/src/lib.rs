@@ -22,7 +22,7 @@ use numpy::{PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crease::analysis::{AnalysisParams, CloudAnalysis};
+use crease::analysis::{AnalysisParams, CloudAnalysis, DEFAULT_MAX_K};
 use crease::estimate::bezier::{bezier_curvature, BezierParams};
 use crease::estimate::curvature::{quadric_curvature_of, QuadricParams};
 use crease::estimate::{self, PcaParams, Weighting};
@@ -33,6 +33,7 @@ use crease::geometry::{names, MeshTopology, PointCloud, TriMesh};
 use crease::io::{Geometry, ReadOptions, WriteOptions};
 use crease::lines::{extract_lines, LinesParams};
 use crease::meshfeat::{detect_edges, feature_polylines, EdgeMethod, EdgeParams};
+use crease::network::{cloud_network, NetworkSummary};
 use crease::segment::{segment_mesh, segment_points, PointParams, SegmentParams};
 use crease::sharp::{detect, detect_mesh, Measure, SharpParams, ThresholdRule};
 
@@ -621,7 +622,7 @@ fn lines<'py>(
 
 /// `crease fillets` (`network` false) and `crease network` (`network` true).
 #[pyfunction]
-#[pyo3(signature = (points, network, k = 20, region_angle = 8.0, spur_length = 5, curvature_k = 20, smoothing = 0, median = 1, trim = 0.005, bins = 50, one_run = false, thresholds = None, max_thresholds = 4, tau = None, coarse_retry = false, boundary = true))]
+#[pyo3(signature = (points, network, k = 20, region_angle = 8.0, spur_length = 5, curvature_k = 20, smoothing = 0, median = 1, trim = 0.005, bins = 50, one_run = false, thresholds = None, max_thresholds = 4, tau = None, coarse_retry = false, boundary = true, lines_from = "surfaces"))]
 #[allow(clippy::too_many_arguments)]
 fn fillets<'py>(
     py: Python<'py>,
@@ -641,7 +642,17 @@ fn fillets<'py>(
     tau: Option<Vec<f64>>,
     coarse_retry: bool,
     boundary: bool,
+    lines_from: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let anchored = match lines_from {
+        "surfaces" => network,
+        "points" => false,
+        other => {
+            return Err(value_error(format!(
+                "lines_from must be 'surfaces' or 'points', got {other:?}"
+            )))
+        }
+    };
     let thresholds = match (tau, thresholds) {
         (Some(t), _) if !t.is_empty() => {
             if t.iter().any(|t| *t < 0.0) {
@@ -687,9 +698,31 @@ fn fillets<'py>(
     }
     let (f, net, seconds) = compute(py, move || {
         let start = Instant::now();
+        if anchored {
+            // As `crease network` (with `--labels`): the lines anchored on the surfaces.
+            let analysis = CloudAnalysis::new(
+                &pos,
+                AnalysisParams {
+                    max_k: DEFAULT_MAX_K.max(params.lines.k),
+                    ..Default::default()
+                },
+            )?;
+            let r = cloud_network(&analysis, &params, true)?;
+            let seconds = start.elapsed().as_secs_f64();
+            let f = r.fillets.ok_or_else(|| {
+                crease::Error::InvalidArgument(
+                    "network: the fillet labels were not computed".into(),
+                )
+            })?;
+            return Ok((f, Some((r.network, r.summary)), seconds));
+        }
         let f = extract_fillets(&pos, &params, network)?;
         let seconds = start.elapsed().as_secs_f64();
-        let net = network.then(|| curve_network(&f));
+        let net = network.then(|| {
+            let net = curve_network(&f);
+            let s = NetworkSummary::new(&net, 0, Some("asked for lines from points".into()));
+            (net, s)
+        });
         Ok((f, net, seconds))
     })?;
     let d = PyDict::new(py);
@@ -705,18 +738,13 @@ fn fillets<'py>(
         "timing": f.seconds,
         "seconds": seconds,
     });
-    if let Some(net) = net {
+    if let Some((net, counts)) = net {
         let (lines, idx) = polylines(py, &net.vertices, &net.polylines)?;
         d.set_item("polylines", lines)?;
         d.set_item("indices", idx)?;
         d.set_item("groups", net.groups())?;
-        summary["network"] = serde_json::json!({
-            "sharp_polylines": net.count(names::SHARP),
-            "smooth_polylines": net.count(names::SMOOTH),
-            "boundary_polylines": net.count(names::BOUNDARY),
-            "joined_smooth_ends": net.joined_ends,
-            "open_smooth_ends": net.open_ends,
-        });
+        summary["network"] =
+            serde_json::to_value(&counts).map_err(|e| value_error(e.to_string()))?;
         d.set_item("vertices", points_array(py, net.vertices)?)?;
     } else {
         let (lines, idx) = polylines(py, &f.lines.vertices, &f.lines.polylines)?;

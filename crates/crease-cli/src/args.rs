@@ -71,7 +71,7 @@ pub enum Command {
     /// Fillet (smooth-edge) lines of a point cloud (Demarsin 2008 curvature histograms).
     Fillets(crate::commands::fillets::FilletsArgs),
     /// The whole curve network of a point cloud: sharp and fillet lines together.
-    Network(crate::commands::fillets::FilletsArgs),
+    Network(crate::commands::fillets::NetworkArgs),
     /// Sharp feature points (multi-scale projected distance with automatic thresholds).
     Sharp(crate::commands::sharp::SharpArgs),
     /// Score a labelled output against ground truth: precision, recall, F1, MCC, IoU, tolerant

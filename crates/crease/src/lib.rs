@@ -22,6 +22,7 @@ pub mod graphcut;
 pub mod io;
 pub mod lines;
 pub mod meshfeat;
+pub mod network;
 pub mod pipeline;
 pub mod render;
 pub mod segment;

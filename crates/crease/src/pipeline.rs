@@ -2,9 +2,10 @@
 //! the Python package's `crease.run` compute.
 //!
 //! * A point cloud ([`run_cloud`]): from one [`CloudAnalysis`] (one neighbour query, one
-//!   segmentation), its sharp points ([`crate::sharp::detect`]), its curve network of sharp and
-//!   fillet lines ([`crate::fillets::extract_fillets_from`], [`curve_network`]), its analytic
-//!   surfaces and its B-rep ([`crate::brep::reconstruct_cloud`]).
+//!   segmentation), its sharp points ([`crate::sharp::detect`]), its analytic surfaces and its
+//!   B-rep ([`crate::brep::reconstruct_cloud`]), and its curve network of sharp and fillet
+//!   lines anchored on them ([`crate::network::anchored`]: the B-rep's edges, and Demarsin's
+//!   lines, [`crate::fillets::extract_fillets_from`], where no surface explains the points).
 //! * A triangle mesh ([`run_mesh`]): its feature edges ([`detect_edges`], the default `fused`
 //!   method) and their polylines, its segmentation into surfaces on the same edge topology, and
 //!   its B-rep from that segmentation.
@@ -20,6 +21,7 @@ use crate::brep::{reconstruct_cloud, reconstruct_segmented_mesh, Reconstruction}
 use crate::fillets::{curve_network, extract_fillets_from, CurveNetwork, FilletParams, Fillets};
 use crate::geometry::TriMesh;
 use crate::meshfeat::{detect_edges, feature_polylines, EdgeDetection, EdgeParams};
+use crate::network::{anchored, NetworkSummary};
 use crate::segment::recognize::Group;
 use crate::segment::{segment_mesh, SegmentParams, SegmentSurface, Segmentation};
 use crate::sharp::{detect, SharpParams, SharpResult};
@@ -67,8 +69,12 @@ pub struct CloudRun {
     pub sharp: SharpResult,
     /// Fillet lines, the per-point fillet labels and the sharp lines they were built with.
     pub fillets: Fillets,
-    /// Sharp, fillet and open-border polylines together.
+    /// Sharp, fillet and open-border polylines together, anchored on the surfaces
+    /// ([`crate::network::anchored`]: the B-rep's edges, Demarsin's lines where no surface
+    /// explains the points).
     pub network: CurveNetwork,
+    /// What the network is made of.
+    pub network_summary: NetworkSummary,
     /// The surface of every point (−1: none).
     pub surface: Vec<i32>,
     /// The `surface_type` code of every point (as [`crate::segment::PointSegmentation::point_types`]; 255: none).
@@ -117,17 +123,24 @@ pub fn run_cloud(analysis: &CloudAnalysis, stage: impl FnMut(Stage)) -> Result<C
     clock.time(NEIGHBOURS, || analysis.neighbours().map(|_| ()))?;
     let seg = clock.time(SEGMENTATION, || analysis.segmentation())?;
     let sharp = clock.time(SHARP_POINTS, || detect(analysis, &SharpParams::default()))?;
-    let (fillets, network) = clock.time(CURVE_NETWORK, || {
-        extract_fillets_from(analysis, &FilletParams::default(), true).map(|f| {
-            let net = curve_network(&f);
-            (f, net)
-        })
-    })?;
     let brep = clock.time(BREP, || reconstruct_cloud(analysis));
+    let params = FilletParams::default();
+    let (fillets, network, network_summary) = clock.time(CURVE_NETWORK, || {
+        let f = extract_fillets_from(analysis, &params, true)?;
+        let points_network = curve_network(&f);
+        let (net, summary) = anchored(
+            analysis,
+            brep.as_ref().map_err(|e| e.to_string()),
+            Some(&points_network),
+            params.lines.d_max,
+        )?;
+        Ok::<_, crate::Error>((f, net, summary))
+    })?;
     Ok(CloudRun {
         sharp,
         fillets,
         network,
+        network_summary,
         surface: analysis.to_input_order(&seg.point_surface),
         surface_type: analysis.to_input_order(&seg.point_types()),
         surfaces: seg.surfaces.clone(),

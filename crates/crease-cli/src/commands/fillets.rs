@@ -1,18 +1,22 @@
 //! `crease fillets IN -o FILLETS.obj [--labels LABELS.ply]`: fillet (smooth-edge) lines of a
 //! point cloud by multi-resolution curvature histograms (Demarsin et al. 2008,
 //! `crease::fillets`), and `crease network IN -o NET.obj`: the whole curve network, sharp and
-//! smooth lines together (OBJ groups `sharp` / `smooth`; PLY vertex property `smooth`).
+//! smooth lines together (OBJ groups `sharp` / `smooth` / `boundary`; PLY vertex property
+//! `smooth`), anchored on the surfaces by default (`crease::network`).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
+use crease::analysis::{AnalysisParams, CloudAnalysis, DEFAULT_MAX_K};
 use crease::fillets::{
-    curve_network, extract_fillets, FilletParams, Fillets, Label, Search, ThresholdCount,
+    curve_network, extract_fillets, CurveNetwork, FilletParams, Fillets, Label, Search,
+    ThresholdCount,
 };
-use crease::geometry::{names, Attribute, PointCloud};
+use crease::geometry::{Attribute, PointCloud};
 use crease::io::Geometry;
 use crease::lines::LinesParams;
+use crease::network::{cloud_network, NetworkSummary};
 
 use crate::args::Global;
 use crate::ui::{usage, Stage};
@@ -91,6 +95,28 @@ pub struct FilletsArgs {
     pub ascii: bool,
 }
 
+/// Arguments of `crease network`.
+#[derive(Args, Debug)]
+pub struct NetworkArgs {
+    #[command(flatten)]
+    pub fillets: FilletsArgs,
+    /// Where the lines come from: `surfaces` (the edges of the B-rep built from the fitted
+    /// surfaces, which average the noise over whole faces; Demarsin's lines where no surface
+    /// explains the points) or `points` (Demarsin's graph lines only, from each point's
+    /// neighbourhood: faster, but they break up under noise of half a spacing).
+    #[arg(long, value_enum, default_value_t = LinesFrom::Surfaces)]
+    pub lines_from: LinesFrom,
+}
+
+/// See [`NetworkArgs::lines_from`].
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinesFrom {
+    /// The B-rep's edges where the surfaces explain the part, Demarsin's lines elsewhere.
+    Surfaces,
+    /// Demarsin's graph lines only.
+    Points,
+}
+
 fn params(a: &FilletsArgs) -> anyhow::Result<FilletParams> {
     let thresholds = if !a.tau.is_empty() {
         if a.tau.iter().any(|t| *t < 0.0) {
@@ -138,8 +164,9 @@ fn params(a: &FilletsArgs) -> anyhow::Result<FilletParams> {
     Ok(params)
 }
 
-/// `crease fillets` (`network` false) and `crease network` (`network` true).
-pub fn run(g: &Global, a: &FilletsArgs, network: bool) -> anyhow::Result<()> {
+/// `crease fillets` (`network` none) and `crease network` (`network`: where its lines come
+/// from).
+pub fn run(g: &Global, a: &FilletsArgs, network: Option<LinesFrom>) -> anyhow::Result<()> {
     crease::io::Format::from_path(&a.output).map_err(|e| usage(e.to_string()))?;
     crate::ui::ensure_not_input(&a.output, &[&a.input])?;
     if let Some(s) = &a.labels {
@@ -158,100 +185,149 @@ pub fn run(g: &Global, a: &FilletsArgs, network: bool) -> anyhow::Result<()> {
     }
     let start = Instant::now();
     let stage = Stage::start(
-        if network {
-            "curve network (Demarsin 2007 + 2008)"
-        } else {
-            "fillet lines (Demarsin 2008)"
+        match network {
+            Some(LinesFrom::Surfaces) => "curve network (B-rep edges + Demarsin 2007/2008)",
+            Some(LinesFrom::Points) => "curve network (Demarsin 2007 + 2008)",
+            None => "fillet lines (Demarsin 2008)",
         },
         g.quiet,
     );
-    let f = extract_fillets(&geom.points.positions, &params, network)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+    let named = |e: crease::Error| anyhow::anyhow!("{}: {e}", a.input.display());
+    let points = &geom.points.positions;
+    let (f, net) = match network {
+        Some(LinesFrom::Surfaces) => {
+            let analysis = CloudAnalysis::new(
+                points,
+                AnalysisParams {
+                    max_k: DEFAULT_MAX_K.max(a.k),
+                    ..Default::default()
+                },
+            )
+            .map_err(named)?;
+            let r = cloud_network(&analysis, &params, a.labels.is_some()).map_err(named)?;
+            (r.fillets, Some((r.network, r.summary)))
+        }
+        Some(LinesFrom::Points) => {
+            let f = extract_fillets(points, &params, true).map_err(named)?;
+            let net = curve_network(&f);
+            let summary = NetworkSummary::new(&net, 0, Some("asked for lines from points".into()));
+            (Some(f), Some((net, summary)))
+        }
+        None => (
+            Some(extract_fillets(points, &params, false).map_err(named)?),
+            None,
+        ),
+    };
     stage.finish();
     let seconds = start.elapsed().as_secs_f64();
 
-    let mut out;
-    let summary_lines;
-    if network {
-        let net = curve_network(&f);
-        let mut cloud = PointCloud::from_positions(net.vertices.clone());
-        let mut smooth_vertex = vec![false; net.vertices.len()];
-        for (l, &s) in net.polylines.iter().zip(&net.smooth) {
-            if s {
-                for &v in l {
-                    smooth_vertex[v as usize] = true;
-                }
-            }
+    let out = match (&net, &f) {
+        (Some((net, _)), _) => network_geometry(net)?,
+        (None, Some(f)) => {
+            let mut out =
+                Geometry::from_cloud(PointCloud::from_positions(f.lines.vertices.clone()));
+            out.polylines = f.lines.polylines.clone();
+            out
         }
-        cloud.set_attribute(Attribute::flag("smooth", smooth_vertex))?;
-        out = Geometry::from_cloud(cloud);
-        out.polylines = net.polylines.clone();
-        out.polyline_groups = net.groups().iter().map(|g| g.to_string()).collect();
-        summary_lines = serde_json::json!({
-            "sharp_polylines": net.count(names::SHARP),
-            "smooth_polylines": net.count(names::SMOOTH),
-            "boundary_polylines": net.count(names::BOUNDARY),
-            "joined_smooth_ends": net.joined_ends,
-            "open_smooth_ends": net.open_ends,
-        });
-    } else {
-        out = Geometry::from_cloud(PointCloud::from_positions(f.lines.vertices.clone()));
-        out.polylines = f.lines.polylines.clone();
-        summary_lines = serde_json::json!({});
-    }
+        (None, None) => unreachable!("the fillet lines are computed without a network"),
+    };
     super::save(g, &a.output, &out, a.ascii, &[&a.input])?;
-    if let Some(path) = &a.labels {
-        let cloud = labelled(&geom.points, &f)?;
+    if let (Some(path), Some(f)) = (&a.labels, &f) {
+        let cloud = labelled(&geom.points, f)?;
         super::save(g, path, &Geometry::from_cloud(cloud), a.ascii, &[&a.input])?;
     }
-    let border = f
-        .label
-        .iter()
-        .filter(|l| **l == Some(Label::Border))
-        .count();
     if g.json {
-        let summary = serde_json::json!({
+        let mut summary = serde_json::json!({
             "input": a.input, "output": a.output, "points": n_points,
             "dropped_nonfinite": report.dropped_nonfinite,
-            "smooth_regions": f.regions.len(),
-            "regions": f.regions,
-            "border_points": border,
-            "polylines": f.lines.polylines.len(),
-            "closed_loops": f.lines.closed_loops(),
-            "junctions": f.lines.junctions(),
-            "endpoints": f.lines.endpoints(),
-            "network": summary_lines,
-            "sharp_stages": f.sharp.as_ref().map(|s| &s.stages),
-            "timing": f.seconds,
             "seconds": seconds,
         });
+        if let Some(f) = &f {
+            let border = f
+                .label
+                .iter()
+                .filter(|l| **l == Some(Label::Border))
+                .count();
+            let fillets = serde_json::json!({
+                "smooth_regions": f.regions.len(),
+                "regions": f.regions,
+                "border_points": border,
+                "polylines": f.lines.polylines.len(),
+                "closed_loops": f.lines.closed_loops(),
+                "junctions": f.lines.junctions(),
+                "endpoints": f.lines.endpoints(),
+                "sharp_stages": f.sharp.as_ref().map(|s| &s.stages),
+                "timing": f.seconds,
+            });
+            if let (Some(map), serde_json::Value::Object(more)) = (summary.as_object_mut(), fillets)
+            {
+                map.extend(more);
+            }
+        }
+        if let Some((_, s)) = &net {
+            summary["network"] = serde_json::to_value(s)?;
+        }
         crate::ui::print_json(&summary)?;
     } else if !g.quiet {
-        let accepted: usize = f
-            .regions
-            .iter()
-            .map(|r| r.thresholds.iter().filter(|t| t.accepted).count())
-            .sum();
-        eprintln!(
-            "wrote {}: {} smooth polylines ({} closed loops, {} endpoints) from {} smooth regions \
-             and {} thresholds, {:.2} s",
-            a.output.display(),
-            f.lines.polylines.len(),
-            f.lines.closed_loops(),
-            f.lines.endpoints(),
-            f.regions.len(),
-            accepted,
-            seconds
-        );
-        if let Some(s) = &f.sharp {
-            eprintln!(
-                "  with {} sharp polylines ({} closed loops)",
-                s.polylines.len(),
-                s.closed_loops()
-            );
+        match (&net, &f) {
+            (Some((_, s)), _) => {
+                eprintln!(
+                    "wrote {}: {} sharp, {} smooth and {} border polylines, {} junctions, {} \
+                     free ends, {} of them B-rep edges{}, {:.2} s",
+                    a.output.display(),
+                    s.sharp_polylines,
+                    s.smooth_polylines,
+                    s.boundary_polylines,
+                    s.junctions,
+                    s.endpoints,
+                    s.from_surfaces,
+                    s.not_anchored
+                        .as_ref()
+                        .map(|w| format!(" (not anchored on surfaces: {w})"))
+                        .unwrap_or_default(),
+                    seconds
+                );
+            }
+            (None, Some(f)) => {
+                let accepted: usize = f
+                    .regions
+                    .iter()
+                    .map(|r| r.thresholds.iter().filter(|t| t.accepted).count())
+                    .sum();
+                eprintln!(
+                    "wrote {}: {} smooth polylines ({} closed loops, {} endpoints) from {} smooth \
+                     regions and {} thresholds, {:.2} s",
+                    a.output.display(),
+                    f.lines.polylines.len(),
+                    f.lines.closed_loops(),
+                    f.lines.endpoints(),
+                    f.regions.len(),
+                    accepted,
+                    seconds
+                );
+            }
+            (None, None) => {}
         }
     }
     Ok(())
+}
+
+/// The network as written: its vertices (with a `smooth` flag) and its polylines in groups.
+fn network_geometry(net: &CurveNetwork) -> anyhow::Result<Geometry> {
+    let mut cloud = PointCloud::from_positions(net.vertices.clone());
+    let mut smooth_vertex = vec![false; net.vertices.len()];
+    for (l, &s) in net.polylines.iter().zip(&net.smooth) {
+        if s {
+            for &v in l {
+                smooth_vertex[v as usize] = true;
+            }
+        }
+    }
+    cloud.set_attribute(Attribute::flag("smooth", smooth_vertex))?;
+    let mut out = Geometry::from_cloud(cloud);
+    out.polylines = net.polylines.clone();
+    out.polyline_groups = net.groups().iter().map(|g| g.to_string()).collect();
+    Ok(out)
 }
 
 /// The input cloud with the per-point fillet outputs as properties.

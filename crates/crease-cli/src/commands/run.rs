@@ -9,7 +9,7 @@
 //! | file | cloud | mesh |
 //! |---|---|---|
 //! | `labels.ply` | the points with `sharp`, `sharpness`, `surface`, `surface_type`, `fillet_label`, `smooth_edge` (input order) | the mesh with per-face `surface`, `surface_type` and an `edge` element with `sharp`, `sharpness` |
-//! | `network.obj` | sharp and fillet polylines (OBJ groups `sharp`, `smooth`) | the feature-edge polylines (group `sharp`) |
+//! | `network.obj` | sharp, fillet and open-border polylines (OBJ groups `sharp`, `smooth`, `boundary`), anchored on the surfaces (`crease::network`) | the feature-edge polylines (group `sharp`) |
 //! | `surfaces.json` | the surfaces with their parameters | the same |
 //! | `part.step` | the B-rep (`crease::brep::reconstruct_cloud` on the same analysis): a solid, or an open shell saying what it leaves out; when none can be built the summary says why | the same (`crease::brep::reconstruct_segmented_mesh` on the same segmentation) |
 //! | `summary.json` | counts, per-stage times, how often each shared piece was computed | the same |
@@ -207,6 +207,7 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
         "boundary_polylines": network.count(names::BOUNDARY),
         "joined_smooth_ends": network.joined_ends,
         "open_smooth_ends": network.open_ends,
+        "curve_network": run.network_summary,
         "analysis": run.counts,
         "brep": brep,
         "timings": timings_json(&run.timings),

@@ -485,11 +485,21 @@ fn run_on_a_cloud_shares_one_analysis_and_writes_every_result() {
         }
     }
     assert_eq!(s["sharp_polylines"], sharp_lines);
-    assert!(
-        (9..=14).contains(&sharp_lines),
-        "{sharp_lines} sharp polylines"
-    );
+    // Anchored on the surfaces: each of the part's 18 sharp curves one edge of the B-rep, the
+    // fillet's two borders its tangent edges, the 12 corners junctions, no free end.
+    assert_eq!(sharp_lines, 18, "{}", s["curve_network"]);
     assert_eq!(smooth_lines, 2, "the fillet's two borders");
+    assert_eq!(
+        s["curve_network"]["from_surfaces"], 20,
+        "{}",
+        s["curve_network"]
+    );
+    assert_eq!(
+        s["curve_network"]["junctions"], 12,
+        "{}",
+        s["curve_network"]
+    );
+    assert_eq!(s["curve_network"]["endpoints"], 0, "{}", s["curve_network"]);
     // The B-rep, from the same analysis (the counts above): a solid of the part's 10 faces,
     // which OpenCASCADE reads as valid with the exact faces.
     assert_eq!(s["brep"]["solid"], true, "{}", s["brep"]);

@@ -2004,6 +2004,23 @@ impl Brep {
     }
 }
 
+/// Points along an edge from its start vertex to its end vertex (a line's two vertices, a
+/// circle's arc, a B-spline's samples), the ends exactly on the vertices.
+pub fn edge_polyline(edge: &BrepEdge, vertices: &[Point3]) -> Vec<Point3> {
+    let (p0, p1) = (vertices[edge.start], vertices[edge.end]);
+    let mut pts = edge_points(edge, vertices);
+    if pts.len() < 2 {
+        return vec![p0, p1];
+    }
+    if edge.start != edge.end && dist(pts[0], p0) > dist(pts[pts.len() - 1], p0) {
+        pts.reverse();
+    }
+    let last = pts.len() - 1;
+    pts[0] = p0;
+    pts[last] = p1;
+    pts
+}
+
 /// Points along an edge: its vertices, a circle's arc, a B-spline's samples.
 fn edge_points(edge: &BrepEdge, vertices: &[Point3]) -> Vec<Point3> {
     let (p0, p1) = (vertices[edge.start], vertices[edge.end]);

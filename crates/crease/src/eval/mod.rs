@@ -9,6 +9,7 @@
 //! [`check_same_points`] checks that a prediction and its ground truth list the same points in
 //! the same order before their labels are compared item by item.
 
+pub mod curves;
 pub mod metrics;
 pub mod roc;
 pub mod tolerant;
@@ -23,6 +24,7 @@ use crate::geometry::{Aabb, Point3};
 use crate::spatial::KdIndex;
 use crate::{Error, Result};
 
+pub use curves::{score_curves, CurveScores};
 pub use metrics::{Confusion, Metrics};
 pub use roc::{roc, Roc, RocPoint};
 pub use tolerant::{

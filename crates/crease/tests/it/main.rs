@@ -20,6 +20,7 @@ mod mesh_topology;
 mod meshfeat;
 mod meshfeat_filtered;
 mod meshfeat_learned;
+mod network;
 mod normals;
 mod render;
 mod ring;
