@@ -847,3 +847,34 @@ fn mutated_files_of_every_format_give_results_or_errors() {
     // Most mutants are refused, and some still read.
     assert!(text.contains(" ok ") && text.contains("error "), "{text}");
 }
+
+/// `crease info` reports a cloud's noise (σ across the surface, `crease::estimate::noise`):
+/// about the σ `crease synth --noise` added (the part's spacing is √(area / n): the cube's
+/// area is 6), zero on a clean cloud, none for a mesh.
+#[test]
+fn info_reports_the_noise_of_a_cloud() {
+    let dir = tempfile::tempdir().unwrap();
+    let noise = |args: &[&str], name: &str| {
+        let f = common::synth(dir.path(), args, name);
+        let out = crease().args(["info", "--json"]).arg(&f).output().unwrap();
+        assert!(out.status.success());
+        let text = crease().arg("info").arg(&f).output().unwrap();
+        let text = String::from_utf8_lossy(&text.stdout).into_owned();
+        (json_of(&out.stdout)["noise"].as_f64(), text)
+    };
+    let (clean, _) = noise(&["synth", "cube", "-n", "20000"], "clean.ply");
+    assert!(clean.unwrap() < 1e-6, "{clean:?}");
+    let (noisy, text) = noise(
+        &["synth", "cube", "-n", "20000", "--noise", "0.5"],
+        "noisy.ply",
+    );
+    let sigma = 0.5 * (6.0f64 / 20000.0).sqrt();
+    let ratio = noisy.unwrap() / sigma;
+    assert!(
+        (0.8..=1.2).contains(&ratio),
+        "measured {ratio} of the noise added"
+    );
+    assert!(text.contains("\nnoise "), "{text}");
+    let (mesh, _) = noise(&["synth", "cube", "--mesh"], "mesh.ply");
+    assert_eq!(mesh, None);
+}

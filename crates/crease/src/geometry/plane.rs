@@ -135,6 +135,16 @@ impl Moments {
         }
     }
 
+    /// No point yet: the moments of other points about p, p itself left out.
+    #[inline]
+    pub(crate) fn without_origin() -> Self {
+        Moments {
+            s1: [0.0; 3],
+            s2: [0.0; 6],
+            m: 0,
+        }
+    }
+
     /// Adds the point at offset `d` from p.
     #[inline]
     pub(crate) fn add(&mut self, d: Point3) {

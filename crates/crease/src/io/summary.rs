@@ -119,6 +119,9 @@ pub struct Summary {
     pub diagonal: Option<f64>,
     /// Mean nearest-neighbour distance.
     pub spacing: Option<f64>,
+    /// Point clouds: the noise, the standard deviation of the points across the surface
+    /// ([`crate::estimate::noise::noise_sigma`]).
+    pub noise: Option<f64>,
     /// Whether normals are stored.
     pub normals: bool,
     /// Whether colours are stored.
@@ -159,6 +162,9 @@ pub fn summarize(geom: &Geometry, report: &ReadReport) -> Summary {
         bbox,
         diagonal: bbox.map(|b| b.diagonal()),
         spacing: average_spacing(pts),
+        noise: (kind == "point cloud")
+            .then(|| crate::estimate::noise::noise_sigma(pts))
+            .flatten(),
         normals: geom.points.normals.is_some(),
         colors: geom.points.colors.is_some(),
         attributes: summarize_attributes(&geom.points.attributes),
@@ -247,6 +253,16 @@ impl std::fmt::Display for Summary {
         match self.spacing {
             Some(s) => writeln!(f, "spacing     {s:.6} (mean nearest-neighbour distance)")?,
             None => writeln!(f, "spacing     undefined (fewer than two distinct points)")?,
+        }
+        if let Some(n) = self.noise {
+            match self.spacing.filter(|&s| s > 0.0) {
+                Some(s) => writeln!(
+                    f,
+                    "noise       {n:.6} ({:.2} × the spacing above; σ of the points across the surface)",
+                    n / s
+                )?,
+                None => writeln!(f, "noise       {n:.6} (σ of the points across the surface)")?,
+            }
         }
         writeln!(
             f,

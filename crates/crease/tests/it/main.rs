@@ -21,6 +21,7 @@ mod meshfeat;
 mod meshfeat_filtered;
 mod meshfeat_learned;
 mod network;
+mod noise;
 mod normals;
 mod render;
 mod ring;
