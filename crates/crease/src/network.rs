@@ -13,9 +13,8 @@
 //! 2. Its group: `smooth` where the normals of its two faces' surfaces differ by less than
 //!    [`TANGENT_DEGREES`] along it, `sharp` otherwise; an edge between two faces of one surface
 //!    (a seam) is no line. An edge with one face is the cloud's open border (`boundary`) where
-//!    no point lies beyond it; otherwise it borders a region the B-rep left out, and its group
-//!    comes the same way from its face's surface and the segmentation's surface of the points
-//!    beyond (from Demarsin's lines along it when those are on none).
+//!    no point lies beyond it; otherwise it borders a region the B-rep left out, and it is kept
+//!    (as `sharp` or `smooth`) where Demarsin's lines of that group run along it.
 //! 3. Where the B-rep leaves points out (regions whose surfaces do not meet their neighbours),
 //!    or when no B-rep can be built or it leaves more than a tenth of the part out
 //!    ([`MIN_ANCHORED`]; the summary says why), Demarsin's lines
@@ -33,8 +32,8 @@ use serde::Serialize;
 use crate::analysis::CloudAnalysis;
 use crate::brep::{reconstruct_cloud, Reconstruction};
 use crate::fillets::{curve_network, extract_fillets_from, CurveNetwork, FilletParams, Fillets};
-use crate::geometry::surface::{signed_distance, surface_normal};
-use crate::geometry::vec3::{cross, dist, dot, normalize, scale, sub};
+use crate::geometry::surface::surface_normal;
+use crate::geometry::vec3::{cross, dist, dot, normalize, sub};
 use crate::geometry::Point3;
 use crate::spatial::KdIndex;
 use crate::Result;
@@ -242,7 +241,7 @@ pub fn anchored(
         .flatten();
     let along = others.map(GroupIndex::new);
     let mut from_surfaces = 0;
-    for (e, (mut pts, group)) in b.edges.iter().zip(polylines) {
+    for (e, (pts, group)) in b.edges.iter().zip(polylines) {
         let group = match group {
             Some(Group::OneSided) => {
                 let face = e
@@ -251,38 +250,10 @@ pub fn anchored(
                     .flatten()
                     .next()
                     .map(|&f| &b.faces[f].surface);
-                let seg = analysis.segmentation()?;
                 match (face, &data) {
-                    (Some(s), Some(data)) => match beyond(data, s, &pts, spacing) {
-                        // The data ends here: the open border.
-                        None => Some(Group::Boundary),
-                        // A region left out lies beyond: the edge's group from the normals of
-                        // the face's surface and of the surface the points beyond lie on.
-                        Some(j) => match usize::try_from(seg.point_surface[j as usize]) {
-                            Ok(l) if l < seg.surfaces.len() => {
-                                let other = &seg.surfaces[l].params;
-                                if meets_tangentially(data, s, other, &pts, spacing) {
-                                    // The border lies where the surfaces touch.
-                                    let moved: Vec<Point3> = pts
-                                        .iter()
-                                        .enumerate()
-                                        .map(|(i, &q)| {
-                                            if i == 0 || i + 1 == pts.len() {
-                                                return q;
-                                            }
-                                            closest_approach(data, s, other, &pts, q, spacing)
-                                                .unwrap_or(q)
-                                        })
-                                        .collect();
-                                    pts = moved;
-                                    Some(Group::Smooth)
-                                } else {
-                                    Some(Group::Sharp)
-                                }
-                            }
-                            _ => along.as_ref().and_then(|a| a.along(&pts, 2.0 * spacing)),
-                        },
-                    },
+                    (Some(s), Some(data)) if !beyond(data, s, &pts, spacing) => {
+                        Some(Group::Boundary)
+                    }
                     _ => along.as_ref().and_then(|a| a.along(&pts, 2.0 * spacing)),
                 }
             }
@@ -365,128 +336,40 @@ fn along_fractions(pts: &[Point3], n: usize) -> Vec<Point3> {
         .collect()
 }
 
-/// At `q` on the one-sided edge `pts` of a face on `surface`: the unit direction in the
-/// surface's tangent plane across the edge, away from the face (the face's side is the one of
-/// the two spots 3 spacings across nearer a point of `data`), and the surface's normal.
-fn away_from_face(
-    data: &KdIndex,
-    surface: &crate::geometry::SurfaceParams,
-    pts: &[Point3],
-    q: Point3,
-    spacing: f64,
-) -> Option<(Point3, Point3)> {
-    let near = |spot: Point3| {
-        data.nearest(&spot, 1)
-            .first()
-            .map_or(f64::INFINITY, |&(_, d2)| d2.sqrt())
-    };
-    // The tangent at q: the chord of the nearest polyline vertices.
-    let i = (0..pts.len())
-        .min_by(|&i, &j| dist(pts[i], q).total_cmp(&dist(pts[j], q)))
-        .unwrap_or(0);
-    let (a, b) = (pts[i.saturating_sub(1)], pts[(i + 1).min(pts.len() - 1)]);
-    let n = surface_normal(surface, q);
-    let across = normalize(cross(n, sub(b, a)))?;
-    let back = scale(across, -1.0);
-    let spot = |d: Point3| [0, 1, 2].map(|k| q[k] + 3.0 * spacing * d[k]);
-    Some(if near(spot(across)) <= near(spot(back)) {
-        (back, n)
-    } else {
-        (across, n)
-    })
-}
-
-/// Where `other` comes closest to the face's `surface` across its one-sided edge at `q`: the
-/// point of `other` nearest to `surface` among those over q + t · away, |t| ≤ 12 spacings.
-fn closest_approach(
-    data: &KdIndex,
-    surface: &crate::geometry::SurfaceParams,
-    other: &crate::geometry::SurfaceParams,
-    pts: &[Point3],
-    q: Point3,
-    spacing: f64,
-) -> Option<Point3> {
-    let (away, _) = away_from_face(data, surface, pts, q, spacing)?;
-    (-24..=24)
-        .map(|t| {
-            let p = [0, 1, 2].map(|k| q[k] + 0.5 * t as f64 * spacing * away[k]);
-            sub(
-                p,
-                scale(surface_normal(other, p), signed_distance(other, p)),
-            )
-        })
-        .min_by(|a, b| {
-            signed_distance(surface, *a)
-                .abs()
-                .total_cmp(&signed_distance(surface, *b).abs())
-        })
-}
-
-/// Whether the face's `surface` and the `other` surface of a region left out beyond its
-/// one-sided edge `pts` meet tangentially: the edge lies where the B-rep's envelope ended, not
-/// where the two meet, so at five points along it they are compared where they come closest
-/// ([`closest_approach`]): the median angle between their normals there under
-/// [`TANGENT_DEGREES`].
-fn meets_tangentially(
-    data: &KdIndex,
-    surface: &crate::geometry::SurfaceParams,
-    other: &crate::geometry::SurfaceParams,
-    pts: &[Point3],
-    spacing: f64,
-) -> bool {
-    let mut angles: Vec<f64> = along_fractions(pts, 5)
-        .into_iter()
-        .filter_map(|q| {
-            let x = closest_approach(data, surface, other, pts, q, spacing)?;
-            let c = dot(surface_normal(surface, x), surface_normal(other, x)).abs();
-            Some(c.clamp(0.0, 1.0).acos().to_degrees())
-        })
-        .collect();
-    if angles.is_empty() {
-        return false;
-    }
-    angles.sort_by(f64::total_cmp);
-    angles[angles.len() / 2] < TANGENT_DEGREES
-}
-
-/// A point of the cloud beyond the one-sided edge `pts` of a face on `surface` (a region left
-/// out lies there; the point at the middle spot that found one), or none (the data ends
-/// there): at most of seven
-/// points q along it, a point within 2 spacings of one of the spots 3 spacings from q on the
-/// side away from the face ([`away_from_face`]), in the surface's tangent plane or turned out
-/// of it by ±45° or ±90° (the region beyond may turn away at a sharp edge).
+/// Whether points of the cloud lie on both sides of the one-sided edge `pts` of a face on
+/// `surface` (a region left out lies beyond it), rather than on one only (the data ends
+/// there): at most of seven points along it, a point within 2 spacings of each of the two
+/// spots 3 spacings away across it, in the surface.
 fn beyond(
     data: &KdIndex,
     surface: &crate::geometry::SurfaceParams,
     pts: &[Point3],
     spacing: f64,
-) -> Option<u32> {
+) -> bool {
     if pts.len() < 2 {
-        return None;
+        return false;
     }
-    let reach = 3.0 * spacing;
-    let nearest = |spot: Point3| {
-        data.nearest(&spot, 1)
-            .first()
-            .map_or((u32::MAX, f64::INFINITY), |&(j, d2)| (j, d2.sqrt()))
-    };
-    let at = |q: Point3, dir: Point3| [0, 1, 2].map(|k| q[k] + reach * dir[k]);
     let spots = along_fractions(pts, 7);
-    let found: Vec<u32> = spots
+    let both = spots
         .iter()
-        .filter_map(|&q| {
-            let (away, n) = away_from_face(data, surface, pts, q, spacing)?;
-            let h = std::f64::consts::FRAC_1_SQRT_2;
-            [(1.0, 0.0), (h, h), (h, -h), (0.0, 1.0), (0.0, -1.0)]
-                .iter()
-                .find_map(|&(c, s)| {
-                    let dir = [0, 1, 2].map(|k| c * away[k] + s * n[k]);
-                    let (j, d) = nearest(at(q, dir));
-                    (d <= 2.0 * spacing).then_some(j)
-                })
+        .filter(|&&q| {
+            // The tangent at q: the chord of the nearest polyline vertices.
+            let i = (0..pts.len())
+                .min_by(|&i, &j| dist(pts[i], q).total_cmp(&dist(pts[j], q)))
+                .unwrap_or(0);
+            let (a, b) = (pts[i.saturating_sub(1)], pts[(i + 1).min(pts.len() - 1)]);
+            let Some(across) = normalize(cross(surface_normal(surface, q), sub(b, a))) else {
+                return false;
+            };
+            [1.0, -1.0].iter().all(|&side| {
+                let spot = [0, 1, 2].map(|k| q[k] + side * 3.0 * spacing * across[k]);
+                data.nearest(&spot, 1)
+                    .first()
+                    .is_some_and(|&(_, d2)| d2.sqrt() <= 2.0 * spacing)
+            })
         })
-        .collect();
-    (2 * found.len() > spots.len()).then(|| found[found.len() / 2])
+        .count();
+    2 * both > spots.len()
 }
 
 /// Demarsin's sharp and smooth vertices, to tell which group runs along an edge.
