@@ -196,7 +196,8 @@ pub fn anchored(
         Err(why) => {
             let others = points_network.ok_or_else(missing)?;
             let mut net = CurveNetwork::default();
-            let keep = not_inside_one_surface(analysis, others)?;
+            let index = KdIndex::new(analysis.points());
+            let keep = not_inside_one_surface(analysis, index.as_ref(), others)?;
             add_pieces(&mut net, others, &keep, 2 * d_max);
             smooth_ends(&mut net);
             let summary = NetworkSummary::new(&net, 0, Some(why));
@@ -234,10 +235,17 @@ pub fn anchored(
         .collect();
     // One-sided edges: the open border where no point lies beyond, otherwise the border of a
     // region left out, kept where Demarsin's lines of a group run along it.
+    // The analysis' points, indexed once for both tests that read them (built only if needed).
+    let index = std::cell::OnceCell::new();
+    let points_index = || {
+        index
+            .get_or_init(|| KdIndex::new(analysis.points()))
+            .as_ref()
+    };
     let data = polylines
         .iter()
         .any(|(_, g)| *g == Some(Group::OneSided))
-        .then(|| KdIndex::new(analysis.points()))
+        .then(points_index)
         .flatten();
     let along = others.map(GroupIndex::new);
     let mut from_surfaces = 0;
@@ -274,7 +282,7 @@ pub fn anchored(
     }
     if let Some(others) = others {
         let off = off_faces(rec, others, spacing)?;
-        let keep = not_inside_one_surface(analysis, others)?;
+        let keep = not_inside_one_surface(analysis, points_index(), others)?;
         let keep: Vec<bool> = off.iter().zip(&keep).map(|(a, b)| *a && *b).collect();
         add_pieces(&mut net, others, &keep, 2 * d_max);
     }
@@ -452,11 +460,15 @@ fn off_faces(rec: &Reconstruction, others: &CurveNetwork, spacing: f64) -> Resul
 
 /// Per vertex of `others`: whether it is not inside one surface of the segmentation (see the
 /// module documentation); the open border's vertices are.
-fn not_inside_one_surface(analysis: &CloudAnalysis, others: &CurveNetwork) -> Result<Vec<bool>> {
+/// `index` holds the analysis' points.
+fn not_inside_one_surface(
+    analysis: &CloudAnalysis,
+    index: Option<&KdIndex>,
+    others: &CurveNetwork,
+) -> Result<Vec<bool>> {
     let seg = analysis.segmentation()?;
     let nbrs = analysis.neighbours()?;
-    let points = analysis.points();
-    let Some(index) = KdIndex::new(points) else {
+    let Some(index) = index else {
         return Ok(vec![true; others.vertices.len()]);
     };
     let labels = &seg.point_surface;

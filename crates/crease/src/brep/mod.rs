@@ -61,7 +61,7 @@ use serde::Serialize;
 
 use crate::estimate::noise::{noise_ratio, NOISE_K, NOISY_RATIO};
 use crate::geometry::surface::{signed_distance, surface_normal};
-use crate::geometry::vec3::{cross, dist, dot, norm, normalize, scale, sub};
+use crate::geometry::vec3::{cross, dist, dot, norm, normalize, scale, segment_distance, sub};
 use crate::geometry::MeshTopology;
 use crate::geometry::{face_areas, face_normals, Aabb, Point3, SurfaceParams, TriMesh};
 use crate::segment::{neighbours_needed, segment_mesh, segment_points, PointParams, SegmentParams};
@@ -213,17 +213,6 @@ impl Curve {
                 .fold(f64::INFINITY, f64::min),
         }
     }
-}
-
-fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
-    let ab = sub(b, a);
-    let l2 = dot(ab, ab);
-    let t = if l2 > 0.0 {
-        (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    dist(p, [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]])
 }
 
 /// An edge: a curve trimmed by two vertices.

@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use crate::geometry::vec3::{dist, dot, sub};
+use crate::geometry::vec3::{dist, segment_distance};
 use crate::geometry::Point3;
 use crate::spatial::KdIndex;
 
@@ -22,18 +22,6 @@ impl CurveScores {
     pub fn coverage_min(&self) -> f64 {
         self.coverage.iter().copied().fold(1.0, f64::min)
     }
-}
-
-/// Distance from `p` to the segment `a`–`b`.
-fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
-    let ab = sub(b, a);
-    let l2 = dot(ab, ab);
-    let t = if l2 > 0.0 {
-        (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    dist(p, [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]])
 }
 
 /// Points along the segments of `lines`, at most `step` apart, with the length each stands for.

@@ -73,6 +73,19 @@ pub fn lerp(a: Point3, b: Point3, t: f64) -> Point3 {
     add(a, scale(sub(b, a), t))
 }
 
+/// Distance from `p` to the segment `a`–`b`.
+#[inline]
+pub fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
+    let ab = sub(b, a);
+    let l2 = dot(ab, ab);
+    let t = if l2 > 0.0 {
+        (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist(p, add(a, scale(ab, t)))
+}
+
 /// Distance from `p` to the line through `q` along the unit direction `d`.
 #[inline]
 pub fn line_distance(p: Point3, q: Point3, d: Point3) -> f64 {

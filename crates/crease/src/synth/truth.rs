@@ -197,19 +197,8 @@ pub(crate) fn arc_point(center: Point3, e1: Point3, e2: Point3, radius: f64, t: 
     add(center, scale(add(scale(e1, c), scale(e2, s)), radius))
 }
 
-/// Distance from `p` to the segment `ab`.
-#[inline]
-pub fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
-    let ab = sub(b, a);
-    let ap = sub(p, a);
-    let l2 = dot(ab, ab);
-    let t = if l2 > 0.0 {
-        (dot(ap, ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    dist(p, add(a, scale(ab, t)))
-}
+/// Distance from `p` to the segment `ab` (the geometry's, re-exported for the tests).
+pub use crate::geometry::vec3::segment_distance;
 
 /// Distance from `p` to the arc `center + r (cos t e1 + sin t e2)`, t in [start, start+sweep].
 #[inline]
