@@ -16,7 +16,11 @@
 //!
 //! Point clouds ([`segment_points`], [`points`]): the same stages 2–4 and 6 over the
 //! symmetrised k-nearest-neighbour graph, with the quadric-fit curvature; stages 2–4 are one
-//! function over any vertex graph ([`crate::spatial::Adjacency`]) for both.
+//! function over any vertex graph ([`crate::spatial::Adjacency`]) for both. Clouds then have
+//! two stages of their own, judged against the noise measured on the seeds (not in the paper,
+//! for scans with noise of half a spacing and more): regions that are one surface within the
+//! noise made one, and curved types given where they clearly explain a region better
+//! (`merge`); fillets made tangent to the planes they round (`tangent`).
 //!
 //! **Model selection (an addition to the paper).** The labels of section 4 decide a seed's type
 //! in the paper. They are fragile where curvature estimates are: equation 3 tells cones from
@@ -55,9 +59,11 @@
 pub mod fit;
 pub mod grow;
 pub mod labels;
+mod merge;
 pub mod points;
 pub mod recognize;
 pub mod score;
+mod tangent;
 
 use std::time::Instant;
 
@@ -337,7 +343,7 @@ fn noise_tolerance<G: Adjacency>(
     seeds: &[(u8, Vec<u32>)],
     fitted: &[Option<(SurfaceType, Fit)>],
     l: f64,
-) -> grow::Tol {
+) -> (grow::Tol, Option<f64>) {
     let (mut d, mut a): (Vec<f64>, Vec<f64>) = seeds
         .par_iter()
         .zip(fitted)
@@ -369,13 +375,14 @@ fn noise_tolerance<G: Adjacency>(
         m.is_finite().then_some(*m)
     };
     let (Some(md), Some(ma)) = (median(&mut d), median(&mut a)) else {
-        return ctx.tol;
+        return (ctx.tol, None);
     };
     // Caps: beyond them the input is too noisy for any surface of its spacing.
-    grow::Tol {
+    let tol = grow::Tol {
         pos: (3.0 * md / 0.6745).min(3.0 * l),
         cos_norm: (3.0 * ma / 1.1774).min(30f64.to_radians()).cos(),
-    }
+    };
+    (tol, Some(md / 0.6745))
 }
 
 /// Fit of `k` to `vs`, trimmed: refitted to the vertices compatible with the fit (equations
@@ -708,12 +715,15 @@ pub(crate) fn segment_graph<G: Adjacency>(
         };
     let mut fitted: Vec<Option<(SurfaceType, Fit)>> = vec![None; seeds.len()];
     let mut ctx = ctx;
+    // The noise of the positions (σ_d of `noise_tolerance`), where measured.
+    let mut sigma = None;
     if params.adapt_to_noise && input.measure_noise {
         // The noise is measured on the fits of the largest seeds (see [`noise_probe`]); the
         // other seeds are fitted once, with the tolerances that measure gives.
         let probe = noise_probe(&seeds);
         fit_seeds(&ctx, &probe, &mut fitted);
-        let wide = noise_tolerance(&ctx, &seeds, &fitted, l);
+        let (wide, measured) = noise_tolerance(&ctx, &seeds, &fitted, l);
+        sigma = measured;
         // Only a clear widening refits the seeds (exact and mildly noisy inputs keep the
         // paper's tolerances, and their results, bit for bit).
         if wide.pos > 1.05 * tol.pos || wide.cos_norm < tol.cos_norm - 1e-4 {
@@ -810,6 +820,30 @@ pub(crate) fn segment_graph<G: Adjacency>(
         grow::refine_borders(&ctx, &mut owner, &mut regions, 3, min_points);
     }
     timings.push(("borders", t.elapsed().as_secs_f64()));
+    if let Some(sigma) = sigma {
+        // One surface within the noise, one region (`merge`).
+        let t = Instant::now();
+        let floor = params.simpler_floor * l;
+        let richer = merge::richer_types(&ctx, &mut regions, floor, min_cone);
+        let merged = merge::merge_regions(&ctx, &mut owner, &mut regions, sigma, floor, min_cone);
+        if richer || merged {
+            grow::refine_borders(&ctx, &mut owner, &mut regions, 3, min_points);
+        }
+        // Fillets tangent to their planes (`tangent`); the border refinement refits freely,
+        // so the tangency is made again on the region each pass gives.
+        for _ in 0..3 {
+            if !tangent::tangent_fillets(&ctx, &owner, &mut regions, sigma, floor) {
+                break;
+            }
+            grow::refine_borders(&ctx, &mut owner, &mut regions, 1, min_points);
+        }
+        tangent::tangent_fillets(&ctx, &owner, &mut regions, sigma, floor);
+        // The merged surfaces explain more: the crease bands they leave are dissolved again.
+        if input.dissolve_crease_bands && (richer || merged) {
+            dissolve_crease_bands(input, &ctx, &mut owner, &mut explained, &mut regions);
+        }
+        timings.push(("merge", t.elapsed().as_secs_f64()));
+    }
     GraphResult {
         owner,
         regions,
@@ -912,27 +946,10 @@ fn dissolve_crease_bands<G: Adjacency>(
             dead[i] = true;
         }
     }
-    if !dead.iter().any(|&d| d) {
-        return;
+    if dead.iter().any(|&d| d) {
+        let alive: Vec<bool> = dead.iter().map(|&d| !d).collect();
+        merge::renumber(owner, regions, &alive);
     }
-    let mut new_id = vec![-1i32; regions.len()];
-    let mut next = 0;
-    for (i, &d) in dead.iter().enumerate() {
-        if !d {
-            new_id[i] = next;
-            next += 1;
-        }
-    }
-    for o in owner.iter_mut() {
-        if *o >= 0 {
-            *o = new_id[*o as usize];
-        }
-    }
-    let mut i = 0;
-    regions.retain(|_| {
-        i += 1;
-        !dead[i - 1]
-    });
 }
 
 /// Whether a grown region `r` (id `id`, its vertices marked in `owner`) is a piece of a

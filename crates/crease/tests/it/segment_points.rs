@@ -299,8 +299,9 @@ fn abc_vertices_as_a_cloud() {
 
 /// Real depth-sensor scans (`../shared/data/scans`, no labels): the noise-adapted tolerances
 /// (`noise_tolerance`) and the hand-over of explained regions keep them segmented. Measured:
-/// RealSense box 97.8 % of the points assigned (17 % with the paper's tolerances), its two
-/// largest surfaces planes 86° apart; Kinect test0 the table one plane of 80 % of the points
+/// RealSense box 99 % of the points assigned (17 % with the paper's tolerances), its three
+/// visible faces the three largest surfaces, one plane each, 86–96° apart (the third was three
+/// planes 5° apart before the merge of `segment::merge`); Kinect test0 the table one plane of 80 % of the points
 /// (a 56 % "cone" of half angle 89° before, 64 % assigned); CurvSurf sample: the plane and one
 /// each of the torus, cylinder, sphere and cone of its objects.
 #[test]
@@ -336,13 +337,17 @@ fn real_scans_are_segmented() {
     assert!(assigned > 0.95, "assigned {assigned}");
     let mut big: Vec<_> = seg.surfaces.iter().collect();
     big.sort_by_key(|s| std::cmp::Reverse(s.vertices));
-    let (a, b) = (normal(big[0]), normal(big[1]));
-    let c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).abs();
-    assert!(
-        c < 0.1,
-        "the box's two largest faces are {}° apart",
-        c.acos().to_degrees()
-    );
+    // Its three visible faces: the three largest surfaces, planes, each one (the depth camera
+    // warps them by a few degrees).
+    for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+        let (a, b) = (normal(big[i]), normal(big[j]));
+        let c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).abs();
+        assert!(
+            c < 0.15,
+            "box faces {i} and {j} are {}° apart",
+            c.acos().to_degrees()
+        );
+    }
     // Kinect: the table is one plane.
     let (n, assigned, seg) = run("scans/kinect-mosd/test0.pcd");
     assert!(assigned > 0.95, "assigned {assigned}");
