@@ -30,6 +30,13 @@ fn network(points: &[[f64; 3]]) -> CloudNetwork {
     cloud_network(&analysis, &FilletParams::default(), false).expect("network")
 }
 
+/// The points of a scan of `../shared/data` (`rel` below it), if the data is there.
+fn scan(rel: &str) -> Option<Vec<[f64; 3]>> {
+    let dir = common::data_dir()?;
+    let (g, _) = crease::io::read(dir.join(rel), &crease::io::ReadOptions::default()).expect(rel);
+    Some(g.points.positions)
+}
+
 /// The polylines of `net` in the groups `groups`, as point lists.
 fn lines(net: &CurveNetwork, groups: &[&str]) -> Vec<Vec<[f64; 3]>> {
     net.polylines
@@ -51,7 +58,7 @@ fn truth(part: &SyntheticPart, kinds: &[CurveKind]) -> Vec<(Vec<[f64; 3]>, bool)
 
 /// Asserts the network of `p` is its exact curve network: one polyline per curve, the
 /// corners as junctions, no free end, coverage and precision at least 0.95 within 2 spacings.
-fn assert_exact(label: &str, p: &SyntheticPart, junctions: usize) {
+fn assert_exact(label: &str, p: &SyntheticPart, junctions: usize) -> CloudNetwork {
     let r = network(&p.cloud.positions);
     let s = &r.summary;
     let all = truth(p, &[CurveKind::Sharp, CurveKind::Smooth]);
@@ -70,6 +77,7 @@ fn assert_exact(label: &str, p: &SyntheticPart, junctions: usize) {
     assert_eq!(s.endpoints, 0, "{label}: {s:?}");
     assert!(scores.coverage_min() >= 0.95, "{label}: {scores:?}");
     assert!(scores.precision >= 0.95, "{label}: {scores:?}");
+    r
 }
 
 /// The cube with isotropic noise of a whole spacing (100k points): its 12 edges and 8 corners
@@ -97,8 +105,7 @@ fn the_box_with_a_hole_at_half_a_spacing() {
 #[test]
 fn fillet_borders_are_the_tangent_edges() {
     let p = part("fillet-chamfer-cone", 60_000, Noise::None);
-    assert_exact("fillet-chamfer-cone", &p, 12);
-    let r = network(&p.cloud.positions);
+    let r = assert_exact("fillet-chamfer-cone", &p, 12);
     assert_eq!(r.summary.smooth_polylines, 2, "{:?}", r.summary);
     assert_eq!(r.summary.joined_smooth_ends, 4, "{:?}", r.summary);
     let smooth = truth(&p, &[CurveKind::Smooth]);
@@ -113,21 +120,29 @@ fn fillet_borders_are_the_tangent_edges() {
     );
 }
 
+/// The same block with isotropic noise of half a spacing (100k points, estimated normals):
+/// the seeds of the fillet are planar within the noise, the merge puts them back into one
+/// cylinder and the tangency its radius (`segment::merge`, `segment::tangent`), so the fillet's
+/// two borders are found and closed, and the whole network is exact. (Before: the fillet two
+/// planes, its borders missed, the least coverage of a curve 0.02.)
+#[test]
+fn fillet_borders_under_half_a_spacing_of_noise() {
+    let p = part("fillet-chamfer-cone", 100_000, Noise::Isotropic(0.5));
+    let r = assert_exact("fillet-chamfer-cone, isotropic 0.5", &p, 12);
+    assert_eq!(r.summary.smooth_polylines, 2, "{:?}", r.summary);
+    assert_eq!(r.summary.joined_smooth_ends, 4, "{:?}", r.summary);
+}
+
 /// A RealSense scan of a cardboard box seen from one side (46k points): Demarsin's graph draws
 /// 224 meandering sharp polylines over its faces; anchored on the surfaces, the box's three
 /// visible edges come out as three straight lines meeting at its corner, with a handful of
 /// short pieces where the B-rep leaves the scan out, and the scan's border apart.
 #[test]
 fn a_real_box_scan_gives_its_visible_edges() {
-    let Some(data) = common::data_dir() else {
+    let Some(points) = scan("scans/realsense-box/caixa.ply") else {
         return;
     };
-    let (g, _) = crease::io::read(
-        data.join("scans/realsense-box/caixa.ply"),
-        &crease::io::ReadOptions::default(),
-    )
-    .expect("caixa.ply");
-    let r = network(&g.points.positions);
+    let r = network(&points);
     let s = &r.summary;
     println!("caixa: {s:?}");
     assert_eq!(s.not_anchored, None);
@@ -163,32 +178,34 @@ fn a_real_box_scan_gives_its_visible_edges() {
     assert!(corner.is_some(), "no vertex joins three long edges");
 }
 
-/// Two crossing cylinders with noise of half a spacing along the normal: the segmentation
-/// misses part of the cylinders, the B-rep leaves a fifth of the part out, so the lines come
-/// from the points, less those inside one surface. Measured (100k points): precision 0.83 and
-/// the least coverage of a curve 0.66, where Demarsin's graph alone gives 217 polylines of
-/// precision 0.32 (`examples/network_synth.rs`).
+/// Two crossing cylinders with noise of half a spacing along the normal: the seeds of the
+/// cylinders are planar within the noise, and the segmentation's merge (`segment::merge`) puts
+/// their strips back into cylinders, so the six curves where they meet the end planes and each
+/// other come out exact. (Before the merge the cylinders were a dozen planar strips, the
+/// B-rep left a fifth of the part out, and the lines had precision 0.83.)
 #[test]
-fn where_the_b_rep_leaves_much_out_the_lines_come_from_the_points() {
+fn two_crossing_cylinders_at_half_a_spacing() {
     let p = part("two-cylinders", 100_000, Noise::AlongNormal(0.5));
-    let r = network(&p.cloud.positions);
-    let all = truth(&p, &[CurveKind::Sharp]);
-    let scores = score_curves(
-        &all,
-        &lines(&r.network, &[names::SHARP, names::SMOOTH]),
-        2.0 * p.spacing,
-    );
-    println!("two-cylinders: {:?}, {scores:?}", r.summary);
-    assert!(
-        r.summary
-            .not_anchored
-            .as_deref()
-            .is_some_and(|w| w.contains("part out")),
-        "{:?}",
-        r.summary
-    );
-    assert!(scores.precision >= 0.8, "{scores:?}");
-    assert!(scores.coverage_min() >= 0.6, "{scores:?}");
+    assert_exact("two-cylinders, normal 0.5", &p, 0);
+}
+
+/// Where no B-rep can be built (another RealSense view of the box, `caixa2.ply`, 20k points:
+/// the surfaces of the clutter around it do not meet), the lines come from the points, less
+/// those inside one surface: a handful of sharp polylines where Demarsin's graph alone draws
+/// about a hundred over the faces.
+#[test]
+fn where_no_b_rep_is_built_the_lines_come_from_the_points() {
+    let Some(points) = scan("scans/realsense-box/caixa2.ply") else {
+        return;
+    };
+    let r = network(&points);
+    println!("caixa2: {:?}", r.summary);
+    assert!(r.summary.not_anchored.is_some(), "{:?}", r.summary);
+    assert_eq!(r.summary.from_surfaces, 0, "{:?}", r.summary);
+    assert!(r.summary.from_points > 0, "{:?}", r.summary);
+    assert!(r.summary.sharp_polylines <= 20, "{:?}", r.summary);
+    let f = extract_fillets(&points, &FilletParams::default(), true).expect("fillets");
+    assert!(curve_network(&f).polylines.len() >= 50);
 }
 
 /// A cube seen from one side, (1, 1, 1): its three visible faces with noise of half a spacing
