@@ -22,7 +22,7 @@ use numpy::{PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crease::analysis::{AnalysisParams, CloudAnalysis, DEFAULT_MAX_K};
+use crease::analysis::{AnalysisParams, CloudAnalysis};
 use crease::estimate::bezier::{bezier_curvature, BezierParams};
 use crease::estimate::curvature::{quadric_curvature_of, QuadricParams};
 use crease::estimate::{self, PcaParams, Weighting};
@@ -33,7 +33,7 @@ use crease::geometry::{names, MeshTopology, PointCloud, TriMesh};
 use crease::io::{Geometry, ReadOptions, WriteOptions};
 use crease::lines::{extract_lines, LinesParams};
 use crease::meshfeat::{detect_edges, feature_polylines, EdgeMethod, EdgeParams};
-use crease::network::{cloud_network, NetworkSummary};
+use crease::network::{network_of_points, NetworkSummary};
 use crease::segment::{segment_mesh, segment_points, PointParams, SegmentParams};
 use crease::sharp::{detect, detect_mesh, Measure, SharpParams, ThresholdRule};
 
@@ -700,14 +700,7 @@ fn fillets<'py>(
         let start = Instant::now();
         if anchored {
             // As `crease network` (with `--labels`): the lines anchored on the surfaces.
-            let analysis = CloudAnalysis::new(
-                &pos,
-                AnalysisParams {
-                    max_k: DEFAULT_MAX_K.max(params.lines.k),
-                    ..Default::default()
-                },
-            )?;
-            let r = cloud_network(&analysis, &params, true)?;
+            let r = network_of_points(&pos, &params, true)?;
             let seconds = start.elapsed().as_secs_f64();
             let f = r.fillets.ok_or_else(|| {
                 crease::Error::InvalidArgument(

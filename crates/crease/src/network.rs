@@ -153,6 +153,25 @@ pub fn cloud_network(
     })
 }
 
+/// [`cloud_network`] in one call on raw points: their analysis built with neighbourhoods large
+/// enough for `params` (`params.lines.k`), then the network.
+///
+/// Errors: those of [`CloudAnalysis::new`] and [`cloud_network`].
+pub fn network_of_points(
+    points: &[Point3],
+    params: &FilletParams,
+    want_fillets: bool,
+) -> Result<CloudNetwork> {
+    let analysis = CloudAnalysis::new(
+        points,
+        crate::analysis::AnalysisParams {
+            max_k: crate::analysis::DEFAULT_MAX_K.max(params.lines.k),
+            ..Default::default()
+        },
+    )?;
+    cloud_network(&analysis, params, want_fillets)
+}
+
 /// Whether the B-rep explains the whole cloud (nothing left out), so that its edges are the
 /// whole network.
 pub fn explains_all(rec: &Reconstruction) -> bool {
@@ -371,9 +390,7 @@ fn beyond(
             };
             [1.0, -1.0].iter().all(|&side| {
                 let spot = [0, 1, 2].map(|k| q[k] + side * 3.0 * spacing * across[k]);
-                data.nearest(&spot, 1)
-                    .first()
-                    .is_some_and(|&(_, d2)| d2.sqrt() <= 2.0 * spacing)
+                data.nearest_one(&spot).1.sqrt() <= 2.0 * spacing
             })
         })
         .count();
@@ -411,11 +428,7 @@ impl GroupIndex {
             index.as_ref().map_or(0, |idx| {
                 spots
                     .iter()
-                    .filter(|q| {
-                        idx.nearest(q, 1)
-                            .first()
-                            .is_some_and(|&(_, d2)| d2.sqrt() <= tol)
-                    })
+                    .filter(|q| idx.nearest_one(q).1.sqrt() <= tol)
                     .count()
             })
         };
@@ -449,12 +462,7 @@ fn off_faces(rec: &Reconstruction, others: &CurveNetwork, spacing: f64) -> Resul
     Ok(others
         .vertices
         .par_iter()
-        .map(|v| {
-            faces
-                .nearest(v, 1)
-                .first()
-                .is_none_or(|&(_, d2)| d2.sqrt() > tol)
-        })
+        .map(|v| faces.nearest_one(v).1.sqrt() > tol)
         .collect())
 }
 

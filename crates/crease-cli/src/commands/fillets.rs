@@ -8,7 +8,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use crease::analysis::{AnalysisParams, CloudAnalysis, DEFAULT_MAX_K};
 use crease::fillets::{
     curve_network, extract_fillets, CurveNetwork, FilletParams, Fillets, Label, Search,
     ThresholdCount,
@@ -16,7 +15,7 @@ use crease::fillets::{
 use crease::geometry::{Attribute, PointCloud};
 use crease::io::Geometry;
 use crease::lines::LinesParams;
-use crease::network::{cloud_network, NetworkSummary};
+use crease::network::{network_of_points, NetworkSummary};
 
 use crate::args::Global;
 use crate::ui::{usage, Stage};
@@ -196,15 +195,7 @@ pub fn run(g: &Global, a: &FilletsArgs, network: Option<LinesFrom>) -> anyhow::R
     let points = &geom.points.positions;
     let (f, net) = match network {
         Some(LinesFrom::Surfaces) => {
-            let analysis = CloudAnalysis::new(
-                points,
-                AnalysisParams {
-                    max_k: DEFAULT_MAX_K.max(a.k),
-                    ..Default::default()
-                },
-            )
-            .map_err(named)?;
-            let r = cloud_network(&analysis, &params, a.labels.is_some()).map_err(named)?;
+            let r = network_of_points(points, &params, a.labels.is_some()).map_err(named)?;
             (r.fillets, Some((r.network, r.summary)))
         }
         Some(LinesFrom::Points) => {

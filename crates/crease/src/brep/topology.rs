@@ -83,36 +83,49 @@ pub(crate) fn check(mesh: &TriMesh) -> Result<()> {
 }
 
 fn half_edges(mesh: &TriMesh) -> Result<HalfEdges<'_>> {
+    use rayon::prelude::*;
     let faces = &mesh.faces[..];
-    let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(faces.len() * 3);
-    for (t, f) in faces.iter().enumerate() {
-        if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
-            return Err(Error::InvalidInput(format!(
-                "reconstruct: triangle {t} repeats a vertex ({} {} {}); clean the mesh first \
-                 (crease convert --clean)",
-                f[0], f[1], f[2]
-            )));
-        }
-        for i in 0..3 {
-            let key = (f[i], f[(i + 1) % 3]);
-            if directed.insert(key, (3 * t + i) as u32).is_some() {
-                return Err(Error::InvalidInput(format!(
-                    "reconstruct: the mesh is not an oriented 2-manifold: the edge {}-{} is \
-                     walked the same way by two triangles (a non-manifold edge or \
-                     inconsistently oriented faces)",
-                    key.0, key.1
-                )));
-            }
-        }
+    if let Some((t, f)) = faces
+        .iter()
+        .enumerate()
+        .find(|(_, f)| f[0] == f[1] || f[1] == f[2] || f[0] == f[2])
+    {
+        return Err(Error::InvalidInput(format!(
+            "reconstruct: triangle {t} repeats a vertex ({} {} {}); clean the mesh first \
+             (crease convert --clean)",
+            f[0], f[1], f[2]
+        )));
     }
-    let mut twin = vec![NONE; faces.len() * 3];
-    for (t, f) in faces.iter().enumerate() {
-        for i in 0..3 {
-            if let Some(&o) = directed.get(&(f[(i + 1) % 3], f[i])) {
-                twin[3 * t + i] = o;
-            }
-        }
+    // Half-edge 3t + i walks f[i] -> f[i + 1]; sorted by (from, to), its twin is found by
+    // binary search (a sort rather than a hash map: parallel, and a third of the time on the
+    // million-triangle envelopes of clouds).
+    let key = |h: usize| {
+        let f = faces[h / 3];
+        (u64::from(f[h % 3]) << 32) | u64::from(f[(h % 3 + 1) % 3])
+    };
+    let mut directed: Vec<(u64, u32)> = (0..faces.len() * 3)
+        .into_par_iter()
+        .map(|h| (key(h), h as u32))
+        .collect();
+    directed.par_sort_unstable();
+    if let Some(w) = directed.windows(2).find(|w| w[0].0 == w[1].0) {
+        return Err(Error::InvalidInput(format!(
+            "reconstruct: the mesh is not an oriented 2-manifold: the edge {}-{} is walked the \
+             same way by two triangles (a non-manifold edge or inconsistently oriented faces)",
+            w[0].0 >> 32,
+            w[0].0 & 0xffff_ffff
+        )));
     }
+    let twin: Vec<u32> = (0..faces.len() * 3)
+        .into_par_iter()
+        .map(|h| {
+            let k = key(h);
+            let back = k.rotate_right(32);
+            directed
+                .binary_search_by_key(&back, |&(k, _)| k)
+                .map_or(NONE, |i| directed[i].1)
+        })
+        .collect();
     Ok(HalfEdges { faces, twin })
 }
 

@@ -261,14 +261,8 @@ pub fn check_same_points(
         .iter()
         .chain(truth)
         .all(|p| p.iter().all(|c| c.is_finite()))
-        && KdIndex::new(truth).is_some_and(|index| {
-            pred.par_iter().all(|q| {
-                index
-                    .nearest(q, 1)
-                    .first()
-                    .is_some_and(|&(_, d2)| d2 <= tol2)
-            })
-        });
+        && KdIndex::new(truth)
+            .is_some_and(|index| pred.par_iter().all(|q| index.nearest_one(q).1 <= tol2));
     let hint = if reordered {
         "; the two files hold the same points in a different order: write the prediction in the ground truth's point order"
     } else {

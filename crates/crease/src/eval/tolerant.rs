@@ -132,12 +132,7 @@ fn matched(from: &[Point3], to: &[Point3], tol: f64) -> u64 {
     };
     let tol2 = tol * tol;
     from.par_iter()
-        .filter(|q| {
-            index
-                .nearest(q, 1)
-                .first()
-                .is_some_and(|&(_, d2)| d2 <= tol2)
-        })
+        .filter(|q| index.nearest_one(q).1 <= tol2)
         .count() as u64
 }
 

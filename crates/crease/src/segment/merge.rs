@@ -52,7 +52,7 @@ pub(crate) const MERGE_SLACK: f64 = 1.1;
 const MIN_CONTACT: usize = 3;
 
 /// Most points of each part a fit reads.
-const PART_SAMPLE: usize = 2048;
+const PART_SAMPLE: usize = 512;
 
 /// A curved type is taken for a region (richer, or the union of two planes) only when its
 /// normal turns by at least this over the region, from the mean normal to the farthest
