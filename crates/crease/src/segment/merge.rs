@@ -8,10 +8,12 @@
 //! two planes. Two steps put such surfaces back together, both judged against the measured
 //! noise σ of the points (`noise_tolerance`'s σ_d):
 //! 1. **a richer type** for a region whose points it explains clearly better: a plane becomes a
-//!    sphere, cylinder or cone, a cylinder a cone or torus, a sphere a torus, when that type's
+//!    sphere, cylinder or cone, a cylinder a cone or torus, a sphere a cylinder, cone or torus
+//!    (a strip of a cylinder under noise of a spacing is often taken for a sphere), when that type's
 //!    RMS distance is at most the current one divided by [`RICHER_GAIN`] (pure noise lowers
 //!    it by a fraction of `Δparameters / n`, a curved strip fitted by a plane by far more)
-//!    and it keeps at least as many points within equations 4 and 5;
+//!    and it keeps 90 % of the points within equations 4 and 5 that the current one held (as
+//!    step 2 asks of each part: the count is a noisy statistic at noise of a spacing);
 //! 2. **merging** adjacent regions: for each pair sharing [`MIN_CONTACT`] graph edges or
 //!    more, the union is fitted with the types of both and, when one is a plane, the curved
 //!    types too (strips of one cylinder); the simplest type whose distances on each of the two
@@ -34,7 +36,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use super::fit::{fit, Fit};
+use super::fit::{fit, refine, rms_distance, Fit};
 use super::grow::{Ctx, Region};
 use crate::geometry::surface::Prepared;
 use crate::geometry::vec3::{add, dot, norm, normalize};
@@ -133,14 +135,31 @@ fn turn(parts: &[&Part], s: &SurfaceParams) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn fit_parts(kind: SurfaceType, parts: &[&Part]) -> Option<Fit> {
+/// The fit of type `kind` to the points of `parts`; also refined from each of `starts` of that
+/// type (the parts' own surfaces), the best kept: under noise of a spacing the normals that
+/// start [`fit`] are poor, and two strips of one cylinder can fit apart from there while
+/// either strip's own cylinder leads to their common one.
+fn fit_parts(kind: SurfaceType, parts: &[&Part], starts: &[&SurfaceParams]) -> Option<Fit> {
     let cat = |f: fn(&Part) -> &Vec<Point3>| -> Vec<Point3> {
         parts.iter().flat_map(|p| f(p).iter().copied()).collect()
     };
     let pts = cat(|p| &p.pts);
     let nrm = cat(|p| &p.nrm);
     let w: Vec<f64> = parts.iter().flat_map(|p| p.w.iter().copied()).collect();
-    fit(kind, &pts, &nrm, &w)
+    let mut best = fit(kind, &pts, &nrm, &w);
+    for &s in starts
+        .iter()
+        .filter(|s| s.kind() == kind && kind != SurfaceType::Plane)
+    {
+        let Some(params) = refine(s, &pts, &w) else {
+            continue;
+        };
+        let rms = rms_distance(&params, &pts, &w);
+        if rms.is_finite() && best.as_ref().is_none_or(|b| rms < b.rms) {
+            best = Some(Fit { params, rms });
+        }
+    }
+    best
 }
 
 fn cone_ok(f: &Fit, min_cone: f64) -> bool {
@@ -156,7 +175,7 @@ fn richer(k: SurfaceType) -> &'static [SurfaceType] {
     match k {
         T::Plane => &[T::Sphere, T::Cylinder, T::Cone],
         T::Cylinder => &[T::Cone, T::Torus],
-        T::Sphere => &[T::Torus],
+        T::Sphere => &[T::Cylinder, T::Cone, T::Torus],
         T::Cone | T::Torus | T::Other => &[],
     }
 }
@@ -177,12 +196,12 @@ pub(crate) fn richer_types<G: Adjacency>(
             let part = Part::of(ctx, &r.vertices);
             let (rms, held) = part.score(ctx, &r.fit.params);
             for &k in richer(r.kind) {
-                let Some(f) = fit_parts(k, &[&part]).filter(|f| cone_ok(f, min_cone)) else {
+                let Some(f) = fit_parts(k, &[&part], &[]).filter(|f| cone_ok(f, min_cone)) else {
                     continue;
                 };
                 let (frms, fheld) = part.score(ctx, &f.params);
                 if frms * RICHER_GAIN + floor <= rms
-                    && fheld >= held
+                    && 10 * fheld >= 9 * held
                     && turn(&[&part], &f.params) >= MIN_TURN_DEGREES.to_radians()
                 {
                     r.kind = k;
@@ -221,7 +240,9 @@ fn judge<G: Adjacency>(
     let bound_a = MERGE_SLACK * rms_a.max(sigma) + floor;
     let bound_b = MERGE_SLACK * rms_b.max(sigma) + floor;
     for k in kinds {
-        let Some(f) = fit_parts(k, &[pa, pb]).filter(|f| cone_ok(f, min_cone)) else {
+        let Some(f) = fit_parts(k, &[pa, pb], &[&ra.fit.params, &rb.fit.params])
+            .filter(|f| cone_ok(f, min_cone))
+        else {
             continue;
         };
         if k != T::Plane && turn(&[pa, pb], &f.params) < MIN_TURN_DEGREES.to_radians() {
