@@ -1074,19 +1074,14 @@ fn run<'py>(
             "fillet_label",
             vec_array(
                 py,
-                r.fillets
-                    .label
-                    .iter()
-                    .map(|&l| code(l))
-                    .collect::<Vec<u8>>(),
+                r.fillet_label.iter().map(|&l| code(l)).collect::<Vec<u8>>(),
             ),
         )?;
         d.set_item(
             "smooth_edge",
             vec_array(
                 py,
-                r.fillets
-                    .label
+                r.fillet_label
                     .iter()
                     .map(|&l| l == Some(Label::Border))
                     .collect::<Vec<bool>>(),

@@ -31,7 +31,9 @@ use serde::Serialize;
 
 use crate::analysis::CloudAnalysis;
 use crate::brep::{reconstruct_cloud, Reconstruction};
-use crate::fillets::{curve_network, extract_fillets_from, CurveNetwork, FilletParams, Fillets};
+use crate::fillets::{
+    curve_network, extract_fillets_from, CurveNetwork, FilletParams, Fillets, Label,
+};
 use crate::geometry::surface::surface_normal;
 use crate::geometry::vec3::{cross, dist, dot, normalize, sub};
 use crate::geometry::Point3;
@@ -176,6 +178,71 @@ pub fn network_of_points(
 /// whole network.
 pub fn explains_all(rec: &Reconstruction) -> bool {
     rec.report.left_out.is_empty() && rec.report.unexplained == 0.0
+}
+
+/// Per-point fillet labels, in the analysis' order, read off a B-rep `rec` that
+/// [`explains_all`] of the cloud of `analysis`, in place of Demarsin's (whose Delaunay rings
+/// were most of the time of `crease run` on a million points): a point whose surface is a
+/// fillet's (not a plane, and meeting a neighbour along a smooth edge, as the network groups
+/// them) is [`Label::Inner`], or [`Label::Border`] within one spacing of such an edge; a point
+/// of any other surface is [`Label::Low`]; an unassigned point (a crease band along a sharp
+/// edge, where Demarsin's regions end too) has none.
+///
+/// Errors: those of the analysis.
+pub fn fillet_labels(analysis: &CloudAnalysis, rec: &Reconstruction) -> Result<Vec<Option<Label>>> {
+    let seg = analysis.segmentation()?;
+    let spacing = seg.mean_edge;
+    let b = &rec.brep;
+    let mut fillet = vec![false; seg.surfaces.len()];
+    let mut along: Vec<Point3> = Vec::new();
+    for e in &b.edges {
+        let [Some(f), Some(g)] = e.faces else {
+            continue;
+        };
+        let (f, g) = (&b.faces[f], &b.faces[g]);
+        if f.surface_id == g.surface_id {
+            continue;
+        }
+        let pts = crate::brep::edge_polyline(e, &b.vertices);
+        if !tangent(&f.surface, &g.surface, &pts) {
+            continue;
+        }
+        for face in [f, g] {
+            if face.surface.kind() != crate::geometry::SurfaceType::Plane {
+                if let Some(x) = fillet.get_mut(face.surface_id) {
+                    *x = true;
+                }
+            }
+        }
+        // The edge sampled at half a spacing.
+        for w in pts.windows(2) {
+            let steps = (dist(w[0], w[1]) / (0.5 * spacing)).ceil().max(1.0) as usize;
+            along.extend((0..steps).map(|i| {
+                let t = i as f64 / steps as f64;
+                std::array::from_fn(|k| w[0][k] + t * (w[1][k] - w[0][k]))
+            }));
+        }
+        along.extend(pts.last().copied());
+    }
+    let index = KdIndex::new(&along);
+    Ok(analysis
+        .points()
+        .par_iter()
+        .zip(&seg.point_surface)
+        .map(|(&p, &s)| {
+            let s = usize::try_from(s).ok()?;
+            Some(if !fillet.get(s).copied().unwrap_or(false) {
+                Label::Low
+            } else if index
+                .as_ref()
+                .is_some_and(|ix| ix.nearest_one(&p).1 <= spacing * spacing)
+            {
+                Label::Border
+            } else {
+                Label::Inner
+            })
+        })
+        .collect())
 }
 
 /// The network anchored on the B-rep `brep` of the cloud of `analysis` (or, when it could not

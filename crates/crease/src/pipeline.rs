@@ -6,6 +6,10 @@
 //!   B-rep ([`crate::brep::reconstruct_cloud`]), and its curve network of sharp and fillet
 //!   lines anchored on them ([`crate::network::anchored`]: the B-rep's edges, and Demarsin's
 //!   lines, [`crate::fillets::extract_fillets_from`], where no surface explains the points).
+//!   Its per-point fillet labels come from the B-rep's fillet faces when the B-rep explains
+//!   every point ([`crate::network::fillet_labels`]), and Demarsin's are not computed at all
+//!   (their Delaunay rings were most of the network's time at a million points); otherwise
+//!   they are Demarsin's.
 //! * A triangle mesh ([`run_mesh`]): its feature edges ([`detect_edges`], the default `fused`
 //!   method) and their polylines, its segmentation into surfaces on the same edge topology, and
 //!   its B-rep from that segmentation.
@@ -18,10 +22,10 @@ use std::time::Instant;
 
 use crate::analysis::{AnalysisCounts, CloudAnalysis};
 use crate::brep::{reconstruct_cloud, reconstruct_segmented_mesh, Reconstruction};
-use crate::fillets::{curve_network, extract_fillets_from, CurveNetwork, FilletParams, Fillets};
+use crate::fillets::{curve_network, extract_fillets_from, CurveNetwork, FilletParams, Label};
 use crate::geometry::TriMesh;
 use crate::meshfeat::{detect_edges, feature_polylines, EdgeDetection, EdgeParams};
-use crate::network::{anchored, NetworkSummary};
+use crate::network::{anchored, explains_all, fillet_labels, NetworkSummary};
 use crate::segment::recognize::Group;
 use crate::segment::{segment_mesh, SegmentParams, SegmentSurface, Segmentation};
 use crate::sharp::{detect, SharpParams, SharpResult};
@@ -67,8 +71,10 @@ const BREP: Stage = Stage {
 pub struct CloudRun {
     /// Sharp points and their sharpness.
     pub sharp: SharpResult,
-    /// Fillet lines, the per-point fillet labels and the sharp lines they were built with.
-    pub fillets: Fillets,
+    /// Per-point fillet labels: from the B-rep's fillet faces where it explains every point
+    /// ([`crate::network::fillet_labels`]), otherwise Demarsin's
+    /// ([`crate::fillets::Fillets::label`]).
+    pub fillet_label: Vec<Option<Label>>,
     /// Sharp, fillet and open-border polylines together, anchored on the surfaces
     /// ([`crate::network::anchored`]: the B-rep's edges, Demarsin's lines where no surface
     /// explains the points).
@@ -125,7 +131,13 @@ pub fn run_cloud(analysis: &CloudAnalysis, stage: impl FnMut(Stage)) -> Result<C
     let sharp = clock.time(SHARP_POINTS, || detect(analysis, &SharpParams::default()))?;
     let brep = clock.time(BREP, || reconstruct_cloud(analysis));
     let params = FilletParams::default();
-    let (fillets, network, network_summary) = clock.time(CURVE_NETWORK, || {
+    let (fillet_label, network, network_summary) = clock.time(CURVE_NETWORK, || {
+        if let Some(rec) = brep.as_ref().ok().filter(|rec| explains_all(rec)) {
+            // The B-rep's edges are the whole network and its faces give the labels.
+            let labels = analysis.to_input_order(&fillet_labels(analysis, rec)?);
+            let (net, summary) = anchored(analysis, Ok(rec), None, params.lines.d_max)?;
+            return Ok((labels, net, summary));
+        }
         let f = extract_fillets_from(analysis, &params, true)?;
         let points_network = curve_network(&f);
         let (net, summary) = anchored(
@@ -134,11 +146,11 @@ pub fn run_cloud(analysis: &CloudAnalysis, stage: impl FnMut(Stage)) -> Result<C
             Some(&points_network),
             params.lines.d_max,
         )?;
-        Ok::<_, crate::Error>((f, net, summary))
+        Ok::<_, crate::Error>((f.label, net, summary))
     })?;
     Ok(CloudRun {
         sharp,
-        fillets,
+        fillet_label,
         network,
         network_summary,
         surface: analysis.to_input_order(&seg.point_surface),

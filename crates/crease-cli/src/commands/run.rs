@@ -159,11 +159,11 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     cloud.set_attribute(uchar(names::SURFACE_TYPE, run.surface_type.iter().copied()))?;
     cloud.set_attribute(uchar(
         names::FILLET_LABEL,
-        run.fillets.label.iter().map(|l| l.map_or(255, |l| l as u8)),
+        run.fillet_label.iter().map(|l| l.map_or(255, |l| l as u8)),
     ))?;
     cloud.set_attribute(Attribute::flag(
         names::SMOOTH_EDGE,
-        run.fillets.label.iter().map(|&l| l == Some(Label::Border)),
+        run.fillet_label.iter().map(|&l| l == Some(Label::Border)),
     ))?;
     let labels = Geometry::from_cloud(cloud);
     super::save(
