@@ -196,18 +196,11 @@ pub fn fillet_labels(analysis: &CloudAnalysis, rec: &Reconstruction) -> Result<V
     let mut fillet = vec![false; seg.surfaces.len()];
     let mut along: Vec<Point3> = Vec::new();
     for e in &b.edges {
-        let [Some(f), Some(g)] = e.faces else {
-            continue;
-        };
-        let (f, g) = (&b.faces[f], &b.faces[g]);
-        if f.surface_id == g.surface_id {
-            continue;
-        }
         let pts = crate::brep::edge_polyline(e, &b.vertices);
-        if !tangent(&f.surface, &g.surface, &pts) {
+        if edge_group(b, e, &pts) != Some(Group::Smooth) {
             continue;
         }
-        for face in [f, g] {
+        for face in e.faces.iter().flatten().map(|&f| &b.faces[f]) {
             if face.surface.kind() != crate::geometry::SurfaceType::Plane {
                 if let Some(x) = fillet.get_mut(face.surface_id) {
                     *x = true;
@@ -243,6 +236,21 @@ pub fn fillet_labels(analysis: &CloudAnalysis, rec: &Reconstruction) -> Result<V
             })
         })
         .collect())
+}
+
+/// The group of B-rep edge `e` (its points `pts`): none for a seam (both faces on one
+/// surface), smooth where its two surfaces are [`tangent`], sharp otherwise, one-sided with a
+/// single face.
+fn edge_group(b: &crate::brep::Brep, e: &crate::brep::BrepEdge, pts: &[Point3]) -> Option<Group> {
+    match e.faces {
+        [Some(f), Some(g)] if b.faces[f].surface_id == b.faces[g].surface_id => None,
+        [Some(f), Some(g)] => Some(if tangent(&b.faces[f].surface, &b.faces[g].surface, pts) {
+            Group::Smooth
+        } else {
+            Group::Sharp
+        }),
+        _ => Some(Group::OneSided),
+    }
 }
 
 /// The network anchored on the B-rep `brep` of the cloud of `analysis` (or, when it could not
@@ -305,17 +313,7 @@ pub fn anchored(
         .par_iter()
         .map(|e| {
             let pts = crate::brep::edge_polyline(e, &b.vertices);
-            let group = match e.faces {
-                [Some(f), Some(g)] if b.faces[f].surface_id == b.faces[g].surface_id => None,
-                [Some(f), Some(g)] => {
-                    Some(if tangent(&b.faces[f].surface, &b.faces[g].surface, &pts) {
-                        Group::Smooth
-                    } else {
-                        Group::Sharp
-                    })
-                }
-                _ => Some(Group::OneSided),
-            };
+            let group = edge_group(b, e, &pts);
             (pts, group)
         })
         .collect();
