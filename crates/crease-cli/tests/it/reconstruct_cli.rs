@@ -581,6 +581,102 @@ fn point_clouds_become_valid_solids_with_their_faces_and_volumes() {
     }
 }
 
+/// `n` points spread evenly (by area) over the cylinder of radius `r` about the z axis from
+/// z = 0 to the plane z = 1 + x tan `tilt`, and over its two ends, as "x y z" lines; with
+/// Gaussian noise of standard deviation `sigma` on each coordinate. A fixed-seed generator
+/// (xorshift), so that the file is the same on every run.
+fn cut_cylinder_cloud(n: usize, r: f64, tilt: f64, sigma: f64) -> String {
+    let pi = std::f64::consts::PI;
+    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let slope = tilt.tan();
+    let top = |x: f64| 1.0 + slope * x;
+    // Areas: the side (its mean height is 1), the bottom disc, the tilted ellipse.
+    let (side, disc) = (2.0 * pi * r, pi * r * r);
+    let total = side + disc + disc / tilt.cos();
+    let mut out = String::new();
+    for _ in 0..n {
+        let u = uniform() * total;
+        let p = if u < side {
+            // Uniform over the unrolled side: heights up to the highest top, the rest refused.
+            loop {
+                let a = uniform() * 2.0 * pi;
+                let (x, y, z) = (r * a.cos(), r * a.sin(), uniform() * top(r));
+                if z <= top(x) {
+                    break [x, y, z];
+                }
+            }
+        } else {
+            let (x, y) = loop {
+                let (x, y) = ((2.0 * uniform() - 1.0) * r, (2.0 * uniform() - 1.0) * r);
+                if x * x + y * y <= r * r {
+                    break (x, y);
+                }
+            };
+            [x, y, if u < side + disc { 0.0 } else { top(x) }]
+        };
+        let mut gauss = || {
+            // Box–Muller.
+            let (a, b) = (uniform().max(1e-300), uniform());
+            (-2.0 * a.ln()).sqrt() * (2.0 * pi * b).cos()
+        };
+        let q = p.map(|c| c + sigma * gauss());
+        out.push_str(&format!("{:.10} {:.10} {:.10}\n", q[0], q[1], q[2]));
+    }
+    out
+}
+
+#[test]
+fn a_cylinder_cut_obliquely_is_bounded_by_an_exact_ellipse() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (r, n) = (0.5, 50_000);
+    // The spacing: the square root of the area per point (about 0.01).
+    for (tilt, sigma) in [(30.0, 0.0), (60.0, 0.0), (30.0, 0.005)] {
+        let name = format!("cut-{tilt}-{sigma}");
+        let cloud = dir.path().join(format!("{name}.xyz"));
+        std::fs::write(
+            &cloud,
+            cut_cylinder_cloud(n, r, f64::to_radians(tilt), sigma),
+        )
+        .expect("cloud written");
+        let step = dir.path().join(format!("{name}.step"));
+        let summary = reconstruct(&cloud, &step);
+        let report = &summary["report"];
+        assert_eq!(summary["solid"], true, "{name}: {summary}");
+        assert_eq!(report["edges_by_curve"]["ellipse"], 1, "{name}: {summary}");
+        assert_eq!(report["edges_by_curve"]["circle"], 1, "{name}: {summary}");
+        let occ = check(&step, Some((&cloud, 25)));
+        assert_eq!(occ["valid"], true, "{name}: {occ}");
+        assert_eq!(occ["solids"], 1, "{name}: {occ}");
+        assert_eq!(
+            faces(&occ),
+            vec![("cylinder".to_string(), 1), ("plane".to_string(), 2)],
+            "{name}: {occ}"
+        );
+        assert!(
+            occ["edges"]["ellipse"].as_u64().unwrap_or(0) >= 1,
+            "{name}: {occ}"
+        );
+        // The volume: the cylinder's section times its mean height 1.
+        let exact = std::f64::consts::PI * r * r;
+        let volume = occ["volume"].as_f64().expect("volume");
+        let tolerance = if sigma == 0.0 { 5e-3 } else { 2e-2 };
+        assert!(
+            (volume - exact).abs() <= tolerance * exact,
+            "{name}: volume {volume} against {exact}"
+        );
+        if sigma == 0.0 {
+            let far = occ["max_distance"].as_f64().expect("distances");
+            assert!(far < 1e-3, "{name}: a point {far} from the B-rep");
+        }
+    }
+}
+
 #[test]
 fn open_clouds_become_open_shells_bounded_where_the_samples_end() {
     let dir = tempfile::tempdir().expect("temp dir");

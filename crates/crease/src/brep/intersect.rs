@@ -1,6 +1,6 @@
 //! Where the faces meet: points on several surfaces at once (the B-rep's vertices, and the
 //! samples of curves without a closed form), and the intersection curve of two adjacent faces,
-//! exact where it is a line or a circle.
+//! exact where it is a line, a circle or an ellipse.
 //!
 //! Points: Levenberg–Marquardt on the signed distances, started from the mesh vertex. With as
 //! many surfaces as unknowns it converges to their common point in Gauss–Newton steps; with
@@ -16,7 +16,8 @@
 //!   edge's start vertex;
 //! - a plane parallel to a cylinder's axis: the line along the axis through the start vertex;
 //!   a plane through a torus's axis: the tube circle through the start vertex;
-//! - anything else (an oblique plane through a cylinder, two crossing cylinders): the cubic
+//! - a plane oblique to a cylinder's axis: their ellipse;
+//! - anything else (an oblique plane through a cone, two crossing cylinders): the cubic
 //!   B-spline interpolating the mesh chain's vertices moved onto both surfaces (`interpolate`);
 //! - the mesh border (one surface): the surface's curve in the border's plane when the border
 //!   is planar, a line where it is straight on a plane, else the degree-1 B-spline through the
@@ -206,8 +207,38 @@ fn circle_through(o: Point3, d: Point3, p: Point3) -> Option<Curve> {
     })
 }
 
+/// The ellipse in which the plane of normal `n` through `start` (a point of the cylinder: the
+/// edge's start vertex, as for circles) cuts the cylinder of axis (`o`, unit `d`) and `radius`
+/// obliquely: centred where the axis crosses the plane, semi-minor axis the radius across the
+/// axis, semi-major axis `radius / |cos φ|` along the plane's steepest line (φ the angle
+/// between the axis and the normal). None when that semi-major axis is longer than `size`
+/// (the part's): the axis then nearly lies in the plane, the edge is a barely curved stretch
+/// of an ellipse centred far off the part, whose arc the edge's chain cannot tell (the
+/// B-spline marched along the intersection serves there).
+fn oblique_cut(
+    (o, d, radius): (Point3, Point3, f64),
+    n: &Point3,
+    start: Point3,
+    size: f64,
+) -> Option<Curve> {
+    let cos = dot(d, *n);
+    if !(radius > 0.0 && radius < size * cos.abs()) {
+        return None;
+    }
+    let center = add(o, scale(d, dot(*n, sub(start, o)) / cos));
+    let minor = normalize(cross(d, *n))?;
+    Some(Curve::Ellipse {
+        center,
+        axis: *n,
+        ref_dir: cross(*n, minor),
+        semi_major: radius / cos.abs(),
+        semi_minor: radius,
+    })
+}
+
 /// The closed-form intersection curve of `a` and `b` through the vertex `start`, if the pair
-/// has one (see the module documentation); `size` scales the "on the axis" test.
+/// has one (see the module documentation); `size` (the part's) scales the "on the axis" test
+/// and bounds an ellipse's axes.
 pub(crate) fn analytic_curve(
     a: &SurfaceParams,
     b: &SurfaceParams,
@@ -254,7 +285,12 @@ pub(crate) fn analytic_curve(
                     SurfaceParams::Cylinder { .. } => Some(line_from(start, end, d)),
                     _ => None,
                 },
-                _ => None,
+                Some(d) => match *s {
+                    SurfaceParams::Cylinder {
+                        axis_point, radius, ..
+                    } => oblique_cut((axis_point, d, radius), normal, start, size),
+                    _ => None,
+                },
             }
         }
         _ => {
@@ -538,5 +574,59 @@ mod tests {
         };
         assert!(dist(center, [1.0, 1.0, 2.0]) < 1e-15 && (radius - 2.0).abs() < 1e-15);
         assert!(parallel(axis, [0.0, 0.0, 1.0]));
+    }
+
+    #[test]
+    fn an_oblique_plane_cuts_a_cylinder_in_an_ellipse_on_both() {
+        // The plane z = 1 + tan 40° (x − 0.2) across the cylinder of radius 0.5 about the
+        // vertical line through (0.2, −0.1).
+        let tilt = 40f64.to_radians();
+        let normal = [-tilt.sin(), 0.0, tilt.cos()];
+        let plane = SurfaceParams::Plane {
+            normal,
+            offset: dot(normal, [0.2, -0.1, 1.0]),
+        };
+        let cylinder = SurfaceParams::Cylinder {
+            axis_point: [0.2, -0.1, -3.0],
+            axis_dir: [0.0, 0.0, 1.0],
+            radius: 0.5,
+        };
+        let start = [0.7, -0.1, 1.0 + 0.5 * tilt.tan()];
+        let curve = analytic_curve(&cylinder, &plane, start, start, 10.0).expect("a curve");
+        let Some((center, _, _, a, b)) = curve.conic() else {
+            panic!("an ellipse expected, got {curve:?}");
+        };
+        assert_eq!(curve.name(), "ellipse");
+        assert!(dist(center, [0.2, -0.1, 1.0]) < 1e-15);
+        assert!((a - 0.5 / tilt.cos()).abs() < 1e-15 && (b - 0.5).abs() < 1e-15);
+        // Every point of it on both surfaces, and at distance 0 from it.
+        for i in 0..32 {
+            let p = super::super::conic_point(curve.conic().expect("conic"), i as f64 * 0.2);
+            assert!(signed_distance(&plane, p).abs() < 1e-14, "{p:?}");
+            assert!(signed_distance(&cylinder, p).abs() < 1e-14, "{p:?}");
+            assert!(curve.distance(p) < 1e-12, "{p:?}");
+        }
+        // The distance from points off it: the nearest of a fine sampling.
+        for q in [
+            [0.2, -0.1, 1.0],
+            [1.3, 0.4, 2.0],
+            [0.25, 0.45, 0.9],
+            [-0.5, -0.1, 0.2],
+        ] {
+            let near = (0..200_000)
+                .map(|i| {
+                    let t = i as f64 * std::f64::consts::TAU / 200_000.0;
+                    dist(
+                        q,
+                        super::super::conic_point(curve.conic().expect("conic"), t),
+                    )
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                (curve.distance(q) - near).abs() < 1e-9,
+                "{q:?}: {} against {near}",
+                curve.distance(q)
+            );
+        }
     }
 }

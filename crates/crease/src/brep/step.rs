@@ -192,6 +192,20 @@ impl Entities {
                 let a = self.placement(*center, *axis, *ref_dir);
                 self.add(format!("CIRCLE('',#{a},{})", real(*radius)))
             }
+            Curve::Ellipse {
+                center,
+                axis,
+                ref_dir,
+                semi_major,
+                semi_minor,
+            } => {
+                let a = self.placement(*center, *axis, *ref_dir);
+                self.add(format!(
+                    "ELLIPSE('',#{a},{},{})",
+                    real(*semi_major),
+                    real(*semi_minor)
+                ))
+            }
             Curve::BSpline {
                 degree,
                 control_points,
