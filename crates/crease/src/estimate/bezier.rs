@@ -429,10 +429,15 @@ fn fit_vertex<G: Adjacency>(
         let (mark, stamp, region) = (&mut s.mark, s.stamp, &mut s.region);
         graph.for_each_neighbor(u, |w| {
             let wi = w as usize;
-            if mark[wi] == stamp || excluded.is_some_and(|e| e[wi]) || dist2(p[wi], pv) >= r2 {
+            if mark[wi] == stamp {
                 return;
             }
+            // Marked once seen, kept or not: whether it belongs depends on it alone, and a
+            // vertex just outside the ball is the neighbour of several inside.
             mark[wi] = stamp;
+            if excluded.is_some_and(|e| e[wi]) || dist2(p[wi], pv) >= r2 {
+                return;
+            }
             region.push(w);
         });
     }
