@@ -16,8 +16,9 @@
 //!   edge's start vertex;
 //! - a plane parallel to a cylinder's axis: the line along the axis through the start vertex;
 //!   a plane through a torus's axis: the tube circle through the start vertex;
-//! - a plane oblique to a cylinder's axis: their ellipse;
-//! - anything else (an oblique plane through a cone, two crossing cylinders): the cubic
+//! - a plane oblique to a cylinder's axis, or across a cone steeper than its generators:
+//!   their ellipse;
+//! - anything else (a plane's parabola or hyperbola on a cone, two crossing cylinders): the cubic
 //!   B-spline interpolating the mesh chain's vertices moved onto both surfaces (`interpolate`);
 //! - the mesh border (one surface): the surface's curve in the border's plane when the border
 //!   is planar, a line where it is straight on a plane, else the degree-1 B-spline through the
@@ -236,6 +237,54 @@ fn oblique_cut(
     })
 }
 
+/// The ellipse in which the plane of normal `n` through `start` (a point of the cone) cuts
+/// the nappe of the cone (`apex`, unit `d`, `half_angle`) that `d` points into, when the plane
+/// crosses every generator of it (steeper than the cone: a closed section): the two
+/// generators in the plane of the axis and `n` meet the plane at the ends of the major axis;
+/// the semi-minor axis is the half chord across that plane through their midpoint, `√(ρ² −
+/// δ²)`, ρ the cone's radius at the midpoint's height and δ the midpoint's distance from the
+/// axis. None for a parabola or a hyperbola, or a major axis longer than `size` (see
+/// [`oblique_cut`]).
+fn conic_section(
+    (apex, d, half_angle): (Point3, Point3, f64),
+    n: &Point3,
+    start: Point3,
+    size: f64,
+) -> Option<Curve> {
+    let offset = dot(*n, start);
+    // The unit direction across the axis in the plane of the axis and the normal.
+    let e = normalize(sub(*n, scale(d, dot(*n, d))))?;
+    let (sin, cos) = half_angle.sin_cos();
+    let mut ends = [[0.0; 3]; 2];
+    for (end, side) in ends.iter_mut().zip([1.0, -1.0]) {
+        let g = add(scale(d, cos), scale(e, side * sin));
+        let along = dot(*n, g);
+        let t = (offset - dot(*n, apex)) / along;
+        if !(t > 0.0 && t.is_finite()) {
+            return None;
+        }
+        *end = add(apex, scale(g, t));
+    }
+    let center = scale(add(ends[0], ends[1]), 0.5);
+    let semi_major = 0.5 * dist(ends[0], ends[1]);
+    let v = sub(center, apex);
+    let h = dot(v, d);
+    let rho = h * sin / cos;
+    let delta = norm(sub(v, scale(d, h)));
+    let semi_minor = (rho * rho - delta * delta).max(0.0).sqrt();
+    if !(semi_minor > 0.0 && semi_major < size) {
+        return None;
+    }
+    let ref_dir = normalize(sub(ends[0], ends[1]))?;
+    Some(Curve::Ellipse {
+        center,
+        axis: *n,
+        ref_dir,
+        semi_major: semi_major.max(semi_minor),
+        semi_minor: semi_minor.min(semi_major),
+    })
+}
+
 /// The closed-form intersection curve of `a` and `b` through the vertex `start`, if the pair
 /// has one (see the module documentation); `size` (the part's) scales the "on the axis" test
 /// and bounds an ellipse's axes.
@@ -289,6 +338,9 @@ pub(crate) fn analytic_curve(
                     SurfaceParams::Cylinder {
                         axis_point, radius, ..
                     } => oblique_cut((axis_point, d, radius), normal, start, size),
+                    SurfaceParams::Cone {
+                        apex, half_angle, ..
+                    } => conic_section((apex, d, half_angle), normal, start, size),
                     _ => None,
                 },
             }
@@ -574,6 +626,51 @@ mod tests {
         };
         assert!(dist(center, [1.0, 1.0, 2.0]) < 1e-15 && (radius - 2.0).abs() < 1e-15);
         assert!(parallel(axis, [0.0, 0.0, 1.0]));
+    }
+
+    #[test]
+    fn a_plane_steeper_than_a_cone_cuts_it_in_an_ellipse_on_both() {
+        // A cone of half angle 30° about an oblique axis, cut 25° off square to its axis at
+        // height 2 (an ellipse), then 70° off (steeper than the generators' 60°: a
+        // hyperbola, no closed form here).
+        let d = normalize([0.3, -0.2, 1.0]).expect("axis");
+        let apex = [0.1, 0.2, -0.3];
+        let cone = SurfaceParams::Cone {
+            apex,
+            axis_dir: d,
+            half_angle: 30f64.to_radians(),
+        };
+        let across = normalize(cross(d, [1.0, 0.0, 0.0])).expect("across");
+        let at = add(apex, scale(d, 2.0));
+        for (tilt, ellipse) in [(25.0f64, true), (70.0, false)] {
+            let t = tilt.to_radians();
+            let normal = add(scale(d, t.cos()), scale(across, t.sin()));
+            let plane = SurfaceParams::Plane {
+                normal,
+                offset: dot(normal, at),
+            };
+            // A point of both: along a generator from the apex, where it crosses the plane.
+            let g = add(
+                scale(d, 30f64.to_radians().cos()),
+                scale(cross(d, across), 30f64.to_radians().sin()),
+            );
+            let start = add(apex, scale(g, dot(normal, sub(at, apex)) / dot(normal, g)));
+            let curve = analytic_curve(&plane, &cone, start, start, 100.0);
+            if !ellipse {
+                assert!(curve.is_none(), "{curve:?}");
+                continue;
+            }
+            let curve = curve.expect("a curve");
+            assert_eq!(curve.name(), "ellipse", "{curve:?}");
+            let conic = curve.conic().expect("conic");
+            assert!(conic.3 >= conic.4, "{conic:?}");
+            for i in 0..32 {
+                let p = super::super::conic_point(conic, i as f64 * 0.2);
+                assert!(signed_distance(&plane, p).abs() < 1e-13, "{p:?}");
+                assert!(signed_distance(&cone, p).abs() < 1e-13, "{tilt}: {p:?}");
+            }
+            assert!(curve.distance(start) < 1e-13);
+        }
     }
 
     #[test]

@@ -40,8 +40,8 @@
 //!
 //! Not yet done (issue "scan to CAD"): a cloud's border where the samples end rather than at
 //! its envelope's rim; surfaces meeting in singular curves (two equal cylinders crossing: a
-//! cross bore) built exactly (they are left out today); a plane's conic
-//! sections of a cone (B-splines today); a whole sphere or torus as one face with a seam edge (two faces
+//! cross bore) built exactly (they are left out today); a plane's parabolas
+//! and hyperbolas on a cone (B-splines today); a whole sphere or torus as one face with a seam edge (two faces
 //! today). The border of an open shell is the surface's curve in the border's plane when the
 //! border is planar (a tube's circular ends), a line where it is straight on a plane, the
 //! mesh's polyline otherwise (for a cloud's ragged envelope rim across a curved surface: the
