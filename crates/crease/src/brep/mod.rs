@@ -2157,13 +2157,10 @@ pub fn edge_polyline(edge: &BrepEdge, vertices: &[Point3]) -> Vec<Point3> {
 /// Points along an edge: its vertices, a circle's arc, a B-spline's samples.
 fn edge_points(edge: &BrepEdge, vertices: &[Point3]) -> Vec<Point3> {
     let (p0, p1) = (vertices[edge.start], vertices[edge.end]);
-    match &edge.curve {
-        Curve::Line { .. } => vec![p0, p1],
-        Curve::BSpline { .. } => edge.curve.samples(),
-        Curve::Circle { .. } | Curve::Ellipse { .. } => {
-            let Some(conic) = edge.curve.conic() else {
-                return vec![p0, p1];
-            };
+    match (&edge.curve, edge.curve.conic()) {
+        (Curve::BSpline { .. }, _) => edge.curve.samples(),
+        (_, None) => vec![p0, p1],
+        (_, Some(conic)) => {
             let tau = std::f64::consts::TAU;
             let (a0, a1) = (conic_parameter(conic, p0), conic_parameter(conic, p1));
             // The arc from p0 to p1 along the edge's direction (a whole turn when closed).
@@ -2241,13 +2238,10 @@ fn loop_area(l: &[(usize, bool)], edges: &[BrepEdge], vertices: &[Point3], n: Po
     let mut pts: Vec<Point3> = Vec::new();
     for &(e, fwd) in l {
         let edge = &edges[e];
-        let mut run: Vec<Point3> = match &edge.curve {
-            Curve::BSpline { control_points, .. } => control_points.clone(),
-            Curve::Circle { .. } | Curve::Ellipse { .. } if edge.start == edge.end => {
+        let mut run: Vec<Point3> = match (&edge.curve, edge.curve.conic()) {
+            (Curve::BSpline { control_points, .. }, _) => control_points.clone(),
+            (_, Some(conic)) if edge.start == edge.end => {
                 // A whole circle or ellipse: its polygon.
-                let Some(conic) = edge.curve.conic() else {
-                    return 0.0;
-                };
                 let s = if edge.curve_sense { 1.0 } else { -1.0 };
                 (0..=32)
                     .map(|i| conic_point(conic, s * std::f64::consts::TAU * i as f64 / 32.0))
