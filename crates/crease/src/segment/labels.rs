@@ -222,3 +222,148 @@ pub fn seed_regions(labels: &[u8], topo: &impl Adjacency, p: &LabelParams) -> Ve
     }
     seeds
 }
+
+/// Local seeds inside a set of vertices that no one surface explains (not in the paper): a
+/// residual set of a noisy cloud can join several surfaces (the twelve fillets and eight
+/// corners of a rounded box, all left to the residual seeds, are one connected set), and a fit
+/// to all of it explains none of them. Each vertex gets its hop distance to the set's border
+/// (a vertex with a neighbour outside the set is at 0); from the deepest vertex not yet in a
+/// patch (ties: smaller id), the patch is the vertices of the set within that many hops, so
+/// it stays inside the set and spans its width. Patches of fewer than `min_size` vertices are
+/// dropped. Returned deepest first; they do not overlap.
+pub fn local_patches(set: &[u32], topo: &impl Adjacency, min_size: usize) -> Vec<Vec<u32>> {
+    use std::collections::HashMap;
+    let index: HashMap<u32, usize> = set.iter().enumerate().map(|(i, &v)| (v, i)).collect();
+    let n = set.len();
+    // Multi-source breadth-first search from the border inwards.
+    let mut depth = vec![u32::MAX; n];
+    let mut queue = Vec::new();
+    for (i, &v) in set.iter().enumerate() {
+        let mut border = false;
+        topo.for_each_neighbor(v as usize, |w| border |= !index.contains_key(&w));
+        if border {
+            depth[i] = 0;
+            queue.push(i);
+        }
+    }
+    let mut head = 0;
+    while head < queue.len() {
+        let i = queue[head];
+        head += 1;
+        topo.for_each_neighbor(set[i] as usize, |w| {
+            if let Some(&j) = index.get(&w) {
+                if depth[j] == u32::MAX {
+                    depth[j] = depth[i] + 1;
+                    queue.push(j);
+                }
+            }
+        });
+    }
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by_key(|&i| (std::cmp::Reverse(depth[i]), set[i]));
+    let mut taken = vec![false; n];
+    let mut hops = vec![u32::MAX; n];
+    let mut patches = Vec::new();
+    for &c in &order {
+        if taken[c] {
+            continue;
+        }
+        let radius = depth[c].min(n as u32);
+        let mut patch = vec![c];
+        let mut seen = vec![c];
+        hops[c] = 0;
+        let mut head = 0;
+        while head < patch.len() {
+            let i = patch[head];
+            head += 1;
+            if hops[i] >= radius {
+                continue;
+            }
+            topo.for_each_neighbor(set[i] as usize, |w| {
+                if let Some(&j) = index.get(&w) {
+                    if hops[j] == u32::MAX {
+                        hops[j] = hops[i] + 1;
+                        seen.push(j);
+                        if !taken[j] {
+                            patch.push(j);
+                        }
+                    }
+                }
+            });
+        }
+        for &i in &seen {
+            hops[i] = u32::MAX;
+        }
+        taken[c] = true;
+        if patch.len() >= min_size {
+            for &i in &patch {
+                taken[i] = true;
+            }
+            patches.push(patch.iter().map(|&i| set[i]).collect());
+        }
+    }
+    patches
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Csr;
+
+    /// A `w × h` grid, each vertex joined to its four neighbours.
+    fn grid(w: usize, h: usize) -> Csr {
+        let mut rows: Vec<Vec<u32>> = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let mut r = Vec::new();
+                if x > 0 {
+                    r.push((y * w + x - 1) as u32);
+                }
+                if x + 1 < w {
+                    r.push((y * w + x + 1) as u32);
+                }
+                if y > 0 {
+                    r.push(((y - 1) * w + x) as u32);
+                }
+                if y + 1 < h {
+                    r.push(((y + 1) * w + x) as u32);
+                }
+                rows.push(r);
+            }
+        }
+        let counts: Vec<u32> = rows.iter().map(|r| r.len() as u32).collect();
+        Csr {
+            offsets: Csr::offsets_from_counts(&counts),
+            indices: rows.concat(),
+        }
+    }
+
+    #[test]
+    fn local_patches_tile_a_strip_from_its_middle_line() {
+        // A strip 40 × 9 inside a 48 × 13 grid (the vertices around it are not in the set):
+        // the middle row is 4 hops from the set's border, so the patches are discs of radius
+        // 4 hops centred on it, disjoint and inside the set.
+        let g = grid(48, 13);
+        let set: Vec<u32> = (2..11)
+            .flat_map(|y| (4..44).map(move |x| (y * 48 + x) as u32))
+            .collect();
+        let patches = local_patches(&set, &g, 20);
+        assert!(patches.len() >= 4, "{} patches", patches.len());
+        let mut seen = std::collections::HashSet::new();
+        for p in &patches {
+            assert!(p.len() >= 20);
+            for v in p {
+                assert!(set.contains(v));
+                assert!(seen.insert(*v), "vertex {v} in two patches");
+            }
+        }
+        // The first patch: the disc of radius 4 around (8, 6), the first vertex of the middle
+        // row 4 hops from the strip's left end too.
+        let first = &patches[0];
+        assert_eq!(first[0], 6 * 48 + 8);
+        assert_eq!(first.len(), 41, "a diamond of radius 4 holds 41 vertices");
+        // A set that is all border (one row) gives no patch of 20.
+        let row: Vec<u32> = (6 * 48 + 4..6 * 48 + 44).map(|v| v as u32).collect();
+        assert!(local_patches(&row, &g, 20).is_empty());
+    }
+}

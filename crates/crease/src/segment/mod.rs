@@ -118,9 +118,12 @@ pub struct SegmentParams {
     /// `th_seed` of the torus, 7) become seeds of any type and grow too, for up to three rounds
     /// (default true). Not in
     /// the paper: small patches whose curvature labels are spoiled by their neighbours (the
-    /// spherical corners between three fillets) get no seed of their own otherwise. (On
-    /// clouds, any grown region along a crease that the surfaces beside it explain to within
-    /// their own noise is dissolved again, residual or not: see `crease_band`.)
+    /// spherical corners between three fillets) get no seed of their own otherwise. A set
+    /// of a cloud that no one surface explains (its best fit off by more than equation 4's tolerance) is
+    /// seeded from local patches instead ([`labels::local_patches`]): under noise the
+    /// fillets left between the planes of a rounded box and its corners are one connected
+    /// set. (On clouds, any grown region along a crease that the surfaces beside it explain
+    /// to within their own noise is dissolved again, residual or not: see `crease_band`.)
     pub residual_seeds: bool,
     /// Angle tolerance (degrees) of the parallel / orthogonal tests of the recognition of
     /// section 6 (default 2); positions are compared within `2 · th_pos` mean edge lengths.
@@ -446,7 +449,13 @@ fn reselect<G: Adjacency>(
         // cone's smallest half angle, and on a refined narrow strip the comparison is no
         // better conditioned (the ABC vertex cloud's conical chamfers, two rings of vertices
         // each, read as cylinders when it was tried).
-        T::Cone => &[T::Plane],
+        // Unless its refits made it slimmer than the slimmest cone the selection takes.
+        T::Cone => match r.fit.params {
+            SurfaceParams::Cone { half_angle, .. } if half_angle < min_cone => {
+                &[T::Plane, T::Cylinder]
+            }
+            _ => &[T::Plane],
+        },
         T::Torus => &[T::Plane, T::Sphere, T::Cylinder, T::Cone],
     };
     let (it, sampled) = fit_sample(&r.vertices);
@@ -786,10 +795,36 @@ pub(crate) fn segment_graph<G: Adjacency>(
             let mut rest = labels::seed_regions(&unowned, topo, &params.labels);
             rest.retain(|(_, vs)| vs.len() >= min);
             rest.sort_by_key(|(_, vs)| std::cmp::Reverse(vs.len()));
-            let fitted: Vec<Option<(SurfaceType, Fit)>> = rest
+            let mut fitted: Vec<Option<(SurfaceType, Fit)>> = rest
                 .par_iter()
                 .map(|(lab, vs)| select_model(&ctx, *lab, vs, params, min_cone, l))
                 .collect();
+            // On clouds whose noise was measured, a set that no one surface explains (no fit,
+            // or its best fit off by more than the position tolerance) is seeded from local
+            // patches instead (`labels::local_patches`), grown after the sets that one
+            // surface explains. Not on meshes: on a free-form tessellation (the grooved
+            // sharp_sphere.off) the patches became small spheres of the wrong radius.
+            let explains =
+                |f: &Option<(SurfaceType, Fit)>| f.is_some_and(|(_, f)| f.rms <= tol.pos);
+            if sigma.is_some() && !fitted.iter().all(explains) {
+                let (kept, split): (Vec<_>, Vec<_>) =
+                    rest.into_iter().zip(fitted).partition(|(_, f)| explains(f));
+                let patches: Vec<(u8, Vec<u32>)> = split
+                    .iter()
+                    .flat_map(|((lab, vs), _)| {
+                        labels::local_patches(vs, topo, 3 * min)
+                            .into_iter()
+                            .map(|p| (*lab, p))
+                    })
+                    .collect();
+                let patch_fits: Vec<Option<(SurfaceType, Fit)>> = patches
+                    .par_iter()
+                    .map(|(lab, vs)| select_model(&ctx, *lab, vs, params, min_cone, l))
+                    .collect();
+                (rest, fitted) = kept.into_iter().unzip();
+                rest.extend(patches);
+                fitted.extend(patch_fits);
+            }
             let before = regions.len();
             for ((_, vs), f) in rest.iter().zip(fitted) {
                 let Some((kind, f)) = f else { continue };

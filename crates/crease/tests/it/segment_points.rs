@@ -436,3 +436,4 @@ fn cloud_segmentation_is_independent_of_the_units() {
         }
     }
 }
+
