@@ -436,4 +436,3 @@ fn cloud_segmentation_is_independent_of_the_units() {
         }
     }
 }
-
