@@ -1099,6 +1099,47 @@ fn build(
             ],
         });
     }
+    // A line from a vertex to itself bounds nothing: the chain between two regions closed on
+    // itself where the intersection was taken for a line (on the Kinect scene a thin pole's
+    // cylinder against the table had such an edge for its only loop, and OpenCASCADE read
+    // the face as the whole infinite cylinder: valid, area 4e98). And a cylinder face bounded
+    // by a single loop around its axis runs to infinity on one side. Their regions go.
+    for e in &edges {
+        if matches!(e.curve, Curve::Line { .. }) && e.start == e.end {
+            failing.push(e.faces.iter().flatten().map(|&r| r as u32).collect());
+            if corner.is_none() {
+                let at = vertices[e.start];
+                corner = Some(format!(
+                    "near ({:.4}, {:.4}, {:.4}), an edge closes on itself as a straight line",
+                    at[0], at[1], at[2]
+                ));
+            }
+        }
+    }
+    for r in 0..nr {
+        let SurfaceParams::Cylinder {
+            axis_point,
+            axis_dir,
+            ..
+        } = surfaces[surface_of_region[r]]
+        else {
+            continue;
+        };
+        let rings = topo.loops[r]
+            .iter()
+            .filter(|l| winding(l, &edges, &vertices, axis_point, axis_dir) != 0)
+            .count();
+        if rings == 1 {
+            failing.push(vec![r as u32]);
+            if corner.is_none() {
+                let at = extent[r].map_or([0.0; 3], |b| b.center());
+                corner = Some(format!(
+                    "near ({:.4}, {:.4}, {:.4}), a cylinder is bounded at one end only",
+                    at[0], at[1], at[2]
+                ));
+            }
+        }
+    }
     // A vertex solved far from where the mesh has it: the surfaces meet, but elsewhere (two
     // nearly coaxial cylinders cross far away).
     let areas = face_areas(mesh);
@@ -2230,6 +2271,39 @@ fn seam_direction(
     }
     let mid = best.1 + 0.5 * best.0;
     normalize([0, 1, 2].map(|k| mid.cos() * u[k] + mid.sin() * v[k]))
+}
+
+/// How many times a loop turns around the axis through `o` along `d` (its edges' points in
+/// the loop's order; 0 for a loop that does not go around it).
+fn winding(
+    l: &[(usize, bool)],
+    edges: &[BrepEdge],
+    vertices: &[Point3],
+    o: Point3,
+    d: Point3,
+) -> i64 {
+    let u = step::perpendicular(d);
+    let v = cross(d, u);
+    let mut pts: Vec<Point3> = Vec::new();
+    for &(e, fwd) in l {
+        let mut p = edge_points(&edges[e], vertices);
+        if !fwd {
+            p.reverse();
+        }
+        pts.extend(p);
+    }
+    let angle = |p: Point3| {
+        let r = sub(p, o);
+        dot(r, v).atan2(dot(r, u))
+    };
+    let tau = std::f64::consts::TAU;
+    let mut total = 0.0;
+    for (a, b) in pts.iter().zip(pts.iter().cycle().skip(1)) {
+        let step =
+            (angle(*b) - angle(*a) + std::f64::consts::PI).rem_euclid(tau) - std::f64::consts::PI;
+        total += step;
+    }
+    (total / tau).round() as i64
 }
 
 /// Signed area of a loop in the plane of normal `n`, from its edges' polylines (vertices and
