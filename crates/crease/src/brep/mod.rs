@@ -1116,20 +1116,41 @@ fn build(
             }
         }
     }
+    // And a loop that goes more than once around the axis of a cylinder or cone and back
+    // bounds no face: its parameter domain overlaps itself (on a Kinect scene a can's
+    // cylinder had one spanning 520°: OpenCASCADE reads a self-intersecting wire).
     for r in 0..nr {
-        let SurfaceParams::Cylinder {
-            axis_point,
-            axis_dir,
-            ..
-        } = surfaces[surface_of_region[r]]
-        else {
-            continue;
+        let (o, d, cylinder) = match surfaces[surface_of_region[r]] {
+            SurfaceParams::Cylinder {
+                axis_point,
+                axis_dir,
+                ..
+            } => (axis_point, axis_dir, true),
+            SurfaceParams::Cone { apex, axis_dir, .. } => (apex, axis_dir, false),
+            _ => continue,
         };
-        let rings = topo.loops[r]
+        let turns: Vec<(i64, f64)> = topo.loops[r]
             .iter()
-            .filter(|l| winding(l, &edges, &vertices, axis_point, axis_dir) != 0)
-            .count();
-        if rings == 1 {
+            .map(|l| winding(l, &edges, &vertices, o, d))
+            .collect();
+        if turns
+            .iter()
+            .any(|&(w, span)| w == 0 && span >= std::f64::consts::TAU)
+        {
+            failing.push(vec![r as u32]);
+            if corner.is_none() {
+                let at = extent[r].map_or([0.0; 3], |b| b.center());
+                corner = Some(format!(
+                    "near ({:.4}, {:.4}, {:.4}), a loop goes around the axis of a {} and back",
+                    at[0],
+                    at[1],
+                    at[2],
+                    if cylinder { "cylinder" } else { "cone" }
+                ));
+            }
+        }
+        let rings = turns.iter().filter(|&&(w, _)| w != 0).count();
+        if cylinder && rings == 1 {
             failing.push(vec![r as u32]);
             if corner.is_none() {
                 let at = extent[r].map_or([0.0; 3], |b| b.center());
@@ -1190,6 +1211,14 @@ fn build(
             {
                 out[r as usize] = true;
             }
+        }
+        for r in (0..nr).filter(|&r| out[r]) {
+            tracing::debug!(
+                "leaving out region {r} (surface {}, a {}, area {:.3e})",
+                surface_of_region[r],
+                surfaces[surface_of_region[r]].kind().name(),
+                region_area[r]
+            );
         }
         let mut triangles: Vec<Vec<u32>> = vec![Vec::new(); nr];
         for (t, &r) in topo.region_of_face.iter().enumerate() {
@@ -2274,14 +2303,15 @@ fn seam_direction(
 }
 
 /// How many times a loop turns around the axis through `o` along `d` (its edges' points in
-/// the loop's order; 0 for a loop that does not go around it).
+/// the loop's order; 0 for a loop that does not go around it), and the angle its points span
+/// about the axis, unwrapped (more than a turn for a loop that overlaps itself there).
 fn winding(
     l: &[(usize, bool)],
     edges: &[BrepEdge],
     vertices: &[Point3],
     o: Point3,
     d: Point3,
-) -> i64 {
+) -> (i64, f64) {
     let u = step::perpendicular(d);
     let v = cross(d, u);
     let mut pts: Vec<Point3> = Vec::new();
@@ -2297,13 +2327,15 @@ fn winding(
         dot(r, v).atan2(dot(r, u))
     };
     let tau = std::f64::consts::TAU;
-    let mut total = 0.0;
+    let (mut total, mut low, mut high) = (0.0, 0.0f64, 0.0f64);
     for (a, b) in pts.iter().zip(pts.iter().cycle().skip(1)) {
         let step =
             (angle(*b) - angle(*a) + std::f64::consts::PI).rem_euclid(tau) - std::f64::consts::PI;
         total += step;
+        low = low.min(total);
+        high = high.max(total);
     }
-    (total / tau).round() as i64
+    ((total / tau).round() as i64, high - low)
 }
 
 /// Signed area of a loop in the plane of normal `n`, from its edges' polylines (vertices and

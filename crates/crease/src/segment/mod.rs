@@ -873,8 +873,12 @@ pub(crate) fn segment_graph<G: Adjacency>(
             grow::refine_borders(&ctx, &mut owner, &mut regions, 1, min_points);
         }
         tangent::tangent_fillets(&ctx, &owner, &mut regions, sigma, floor);
+        let plainer = merge::plainer_types(&ctx, &mut regions, l);
+        if plainer {
+            grow::refine_borders(&ctx, &mut owner, &mut regions, 1, min_points);
+        }
         // The merged surfaces explain more: the crease bands they leave are dissolved again.
-        if input.dissolve_crease_bands && (richer || merged) {
+        if input.dissolve_crease_bands && (richer || merged || plainer) {
             dissolve_crease_bands(input, &ctx, &mut owner, &mut explained, &mut regions);
         }
         timings.push(("merge", t.elapsed().as_secs_f64()));
