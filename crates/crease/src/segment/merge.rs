@@ -191,6 +191,17 @@ fn richer(k: SurfaceType) -> &'static [SurfaceType] {
     }
 }
 
+/// Gives region `r` the type `k` with `f`, its fit to `part`; refitted to all the region's
+/// points when `part` is a sample of them.
+fn retype<G: Adjacency>(ctx: &Ctx<G>, r: &mut Region, part: &Part, k: SurfaceType, f: Fit) {
+    r.kind = k;
+    r.fit = if part.pts.len() < r.vertices.len() {
+        ctx.fit(k, &r.vertices).unwrap_or(f)
+    } else {
+        f
+    };
+}
+
 /// Step 1 of the module documentation on every region; returns whether any changed.
 pub(crate) fn richer_types<G: Adjacency>(
     ctx: &Ctx<G>,
@@ -215,12 +226,7 @@ pub(crate) fn richer_types<G: Adjacency>(
                     && 10 * fheld >= 9 * held
                     && turn(&[&part], &f.params) >= MIN_TURN_DEGREES.to_radians()
                 {
-                    r.kind = k;
-                    r.fit = if part.pts.len() < r.vertices.len() {
-                        ctx.fit(k, &r.vertices).unwrap_or(f)
-                    } else {
-                        f
-                    };
+                    retype(ctx, r, &part, k, f);
                     return true;
                 }
             }
@@ -260,12 +266,7 @@ pub(crate) fn plainer_types<G: Adjacency>(ctx: &Ctx<G>, regions: &mut [Region], 
             if 10 * plane_held < 9 * held {
                 return false;
             }
-            r.kind = SurfaceType::Plane;
-            r.fit = if part.pts.len() < r.vertices.len() {
-                ctx.fit(SurfaceType::Plane, &r.vertices).unwrap_or(f)
-            } else {
-                f
-            };
+            retype(ctx, r, &part, SurfaceType::Plane, f);
             true
         })
         .reduce(|| false, |a, b| a || b)
