@@ -1668,10 +1668,25 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
             env.pieces, env.radius
         )));
     }
-    // Each envelope vertex takes the majority surface of its 8 nearest assigned samples (ties:
-    // the nearest); a triangle the surface of two or three of its corners.
-    let vertex_label: Vec<i32> = env
-        .mesh
+    // A sheet (an open surface, a single-view scan): the envelope's front only.
+    let normals = analysis.normals()?;
+    let mesh = match envelope::front_side(&env.mesh, points, normals, &index) {
+        Some(keep) => {
+            let faces: Vec<[u32; 3]> = env
+                .mesh
+                .faces
+                .iter()
+                .zip(&keep)
+                .filter(|(_, &k)| k)
+                .map(|(f, _)| *f)
+                .collect();
+            compact(&env.mesh.vertices.positions, faces)?
+        }
+        None => env.mesh,
+    };
+    // Each vertex takes the majority surface of its 8 nearest assigned samples (ties: the
+    // nearest); a triangle the surface of two or three of its corners.
+    let vertex_label: Vec<i32> = mesh
         .vertices
         .positions
         .par_iter()
@@ -1694,30 +1709,7 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
             best.1
         })
         .collect();
-    let face_labels = face_labels_from_vertices(&env.mesh.faces, &vertex_label);
-    // A sheet (an open surface, a single-view scan): the envelope's front only.
-    let normals = analysis.normals()?;
-    let front = envelope::front_side(&env.mesh, points, normals, &index);
-    let (mesh, face_labels) = match front {
-        Some(keep) => {
-            let faces: Vec<[u32; 3]> = env
-                .mesh
-                .faces
-                .iter()
-                .zip(&keep)
-                .filter(|(_, &k)| k)
-                .map(|(f, _)| *f)
-                .collect();
-            let labels: Vec<i32> = face_labels
-                .iter()
-                .zip(&keep)
-                .filter(|(_, &k)| k)
-                .map(|(l, _)| *l)
-                .collect();
-            (compact(&env.mesh.vertices.positions, faces)?, labels)
-        }
-        None => (env.mesh, face_labels),
-    };
+    let face_labels = face_labels_from_vertices(&mesh.faces, &vertex_label);
     // Residuals, extents, areas and centroids on the points.
     let (stats, rms) = face_stats(
         &surfaces,
