@@ -436,3 +436,30 @@ fn cloud_segmentation_is_independent_of_the_units() {
         }
     }
 }
+
+/// Under noise of half a spacing the rounded cube's planes take the first part of each fillet's
+/// arc (within the widened tolerances) and the middle of the arc, a 45° strip, passes for a
+/// plane; `segment::tangent` makes such a strip the cylinder tangent to its two planes, and
+/// the border refinement gives it back its flanks. Measured (50k points, normals estimated): 7
+/// cylinders and 11 planes before, the 12 fillets and 6 faces after, radii 0.102–0.105 (the 8
+/// corner spheres are not found yet).
+#[test]
+fn noisy_rounded_cube_fillet_strips_become_cylinders_tangent_to_their_planes() {
+    let part = common::noisy_part("rounded-cube", 50_000, 0.5);
+    let seg = segment_default(&part.cloud.positions);
+    let count = |k: SurfaceType| seg.surfaces.iter().filter(|s| s.kind == k).count();
+    let radii: Vec<f64> = seg
+        .surfaces
+        .iter()
+        .filter_map(|s| match s.params {
+            crease::geometry::SurfaceParams::Cylinder { radius, .. } => Some(radius),
+            _ => None,
+        })
+        .collect();
+    eprintln!("rounded cube at 0.5 spacings: cylinder radii {radii:?}");
+    assert_eq!(count(SurfaceType::Plane), 6, "{:?}", seg.surfaces);
+    assert_eq!(count(SurfaceType::Cylinder), 12, "{:?}", seg.surfaces);
+    for r in radii {
+        assert!((r - 0.1).abs() < 0.007, "fillet radius {r} for 0.1");
+    }
+}
