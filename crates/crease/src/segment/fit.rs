@@ -113,7 +113,7 @@ fn p3(v: Vector3<f64>) -> Point3 {
 }
 
 /// Weighted centroid.
-fn centroid(pts: &[Point3], w: &[f64]) -> Option<Point3> {
+pub(crate) fn centroid(pts: &[Point3], w: &[f64]) -> Option<Point3> {
     let mut s = [0.0; 3];
     let mut ws = 0.0;
     for (&p, &wi) in pts.iter().zip(w) {

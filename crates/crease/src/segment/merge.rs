@@ -50,7 +50,7 @@ use rayon::prelude::*;
 use super::fit::{fit, refine, rms_distance, Fit};
 use super::grow::{Ctx, Region};
 use crate::geometry::surface::Prepared;
-use crate::geometry::vec3::{add, dist, dot, norm, normalize, scale};
+use crate::geometry::vec3::{add, dist, dot, norm, normalize};
 use crate::geometry::{Point3, SurfaceParams, SurfaceType};
 use crate::spatial::Adjacency;
 
@@ -117,13 +117,7 @@ impl Part {
 
     /// The weighted centroid of the sample (None when it weighs nothing).
     pub fn centroid(&self) -> Option<Point3> {
-        let mut c = [0.0; 3];
-        let mut ws = 0.0;
-        for (&p, &w) in self.pts.iter().zip(&self.w) {
-            c = add(c, scale(p, w));
-            ws += w;
-        }
-        (ws > 0.0).then(|| scale(c, 1.0 / ws))
+        super::fit::centroid(&self.pts, &self.w)
     }
 
     /// Weighted RMS distance to `s` and the number of points within equations 4 and 5.
