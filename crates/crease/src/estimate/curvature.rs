@@ -31,6 +31,7 @@
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
+use crate::geometry::normal_eq::{add_outer_unit, symmetrize};
 use crate::geometry::vec3::{add, cross, dot, normalize, scale, sub};
 use crate::geometry::Point3;
 use crate::spatial::Neighborhoods;
@@ -355,13 +356,14 @@ pub(crate) fn fit_point(points: &[Point3], i: usize, row: &[u32]) -> PointCurvat
     let mut add_sample = |d: Point3| {
         let (x, y, z) = (dot(d, e1) * inv, dot(d, e2) * inv, dot(d, n) * inv);
         let m = SVector::<f64, 6>::from([x * x, x * y, y * y, x, y, 1.0]);
-        ata += m * m.transpose();
+        add_outer_unit(&mut ata, &m);
         atb += m * z;
     };
     add_sample([0.0; 3]);
     for &j in row {
         add_sample(sub(points[j as usize], p));
     }
+    symmetrize(&mut ata);
     let Some(chol) = ata.cholesky() else {
         return PointCurvature::FAILED;
     };

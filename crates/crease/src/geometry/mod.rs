@@ -6,6 +6,7 @@ pub mod cleanup;
 mod csr;
 mod mesh;
 pub mod names;
+pub(crate) mod normal_eq;
 pub mod plane;
 mod point_cloud;
 pub mod polyline;

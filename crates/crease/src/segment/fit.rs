@@ -42,6 +42,7 @@
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector3};
 use rayon::prelude::*;
 
+use crate::geometry::normal_eq::{add_outer, symmetrize};
 use crate::geometry::surface::{meridian, radial, signed_distance, Prepared};
 use crate::geometry::vec3::{add, cross, dist2, dot, norm, normalize, scale, sub};
 use crate::geometry::{Point3, SurfaceParams, SurfaceType};
@@ -1033,7 +1034,7 @@ fn lm<const N: usize, M: Model<N>>(
                 let mut jtr = SVector::<f64, N>::zeros();
                 for (&p, &wi) in p.iter().zip(w) {
                     let (r, g) = at.row(p);
-                    jtj += g * g.transpose() * wi;
+                    add_outer(&mut jtj, &g, wi);
                     jtr += g * (r * wi);
                 }
                 (jtj, jtr)
@@ -1045,6 +1046,7 @@ fn lm<const N: usize, M: Model<N>>(
             jtj += a;
             jtr += b;
         }
+        symmetrize(&mut jtj);
         (jtj, jtr)
     };
     let mut x = [0.0; N];
