@@ -50,24 +50,70 @@ pub(crate) fn ratio_at(u: f64) -> f64 {
 
 /// The u in [0, 1] with ρ(u) = `ratio` (ρ decreases from 0.750 at u = 0 to 0 at u = 1); 0 for
 /// a ratio at or above ρ(0) (a corner of the sheet, or beyond its rim), 1 for a ratio of 0.
+///
+/// The root is bracketed in a table of ρ at [`RATIO_TABLE`] + 1 even steps of u, then found
+/// by false position (Illinois variant) to 1e-13 in u: about 5 evaluations of ρ where the
+/// bisection it replaced took 40, which made ρ's arcsine 5 % of `crease run` on a noisy
+/// million-point cloud.
 pub(crate) fn distance_fraction(ratio: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    if ratio.is_nan() {
+        return 0.0;
+    }
     if ratio >= ratio_at(0.0) {
         return 0.0;
     }
     if ratio <= 0.0 {
         return 1.0;
     }
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if ratio_at(mid) > ratio {
-            lo = mid;
+    let table = TABLE.get_or_init(|| {
+        (0..=RATIO_TABLE)
+            .map(|i| ratio_at(i as f64 / RATIO_TABLE as f64))
+            .collect()
+    });
+    // table[0] = ρ(0) > ratio > 0 = table[RATIO_TABLE]: the first entry at or below the ratio
+    // closes the bracket.
+    let i = table.partition_point(|&v| v > ratio).clamp(1, RATIO_TABLE);
+    let (mut a, mut b) = (
+        (i - 1) as f64 / RATIO_TABLE as f64,
+        i as f64 / RATIO_TABLE as f64,
+    );
+    // f = ρ − ratio: positive at a, at most zero at b.
+    let (mut fa, mut fb) = (table[i - 1] - ratio, table[i] - ratio);
+    if fb == 0.0 {
+        return b;
+    }
+    let mut side = 0i8;
+    for _ in 0..60 {
+        if b - a <= 1e-13 {
+            break;
+        }
+        let x = ((a * fb - b * fa) / (fb - fa)).clamp(a, b);
+        let fx = ratio_at(x) - ratio;
+        if fx == 0.0 {
+            return x;
+        }
+        if fx > 0.0 {
+            a = x;
+            fa = fx;
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
         } else {
-            hi = mid;
+            b = x;
+            fb = fx;
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
         }
     }
-    0.5 * (lo + hi)
+    0.5 * (a + b)
 }
+
+/// Steps of the table that brackets ρ's inverse in [`distance_fraction`].
+const RATIO_TABLE: usize = 256;
 
 /// The distance from point `p` to the rim of its sheet (length units), from the plane through
 /// it and its nearest neighbours `near` (see the module documentation; `radius` is the distance
@@ -122,6 +168,15 @@ mod tests {
                 ratio_at(u)
             );
             assert!((distance_fraction(ratio_at(u)) - u).abs() < 1e-9);
+        }
+        // The inverse everywhere, near both ends too.
+        for i in 0..=2000 {
+            let u = i as f64 / 2000.0;
+            let r = ratio_at(u);
+            if r > 0.0 && r < ratio_at(0.0) {
+                let got = distance_fraction(r);
+                assert!((ratio_at(got) - r).abs() < 1e-12, "u = {u}: {got}");
+            }
         }
         assert_eq!(distance_fraction(0.9), 0.0);
         assert_eq!(distance_fraction(0.0), 1.0);
