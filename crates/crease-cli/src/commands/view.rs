@@ -130,7 +130,13 @@ pub fn write_view(
     polylines: Vec<Polyline>,
     params: &PageParams,
 ) -> anyhow::Result<usize> {
-    let mesh = geom.clone().into_mesh();
+    // A cloud is shown as it is: no copy of its points and attributes (a million points with
+    // the labels of `crease run` are 170 MB).
+    let mesh = if geom.is_mesh() {
+        geom.clone().into_mesh()
+    } else {
+        None
+    };
     let scene = Scene {
         points: if mesh.is_none() {
             Some(&geom.points)

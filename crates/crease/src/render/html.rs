@@ -230,21 +230,25 @@ fn layers(polylines: &[Polyline], centre: Point3, blocks: &mut Blocks) -> Vec<se
 pub fn page(scene: &Scene<'_>, params: &PageParams) -> Result<String> {
     let cloud = scene.points.or(scene.mesh.map(|m| &m.vertices));
     let positions: &[Point3] = cloud.map_or(&[], |c| &c.positions);
-    let mut all: Vec<Point3> = positions.to_vec();
-    all.extend(
-        scene
-            .polylines
+    let all = || {
+        positions
             .iter()
-            .flat_map(|l| l.points.iter().copied()),
-    );
-    let b = Aabb::from_points(&all)
-        .ok_or_else(|| Error::InvalidInput("a view of nothing: no point, face or line".into()))?;
-    if all.iter().flatten().any(|v| !v.is_finite()) {
+            .chain(scene.polylines.iter().flat_map(|l| l.points.iter()))
+    };
+    let mut b: Option<Aabb> = None;
+    for &p in all() {
+        match b.as_mut() {
+            Some(b) => b.grow(p),
+            None => b = Aabb::from_points(&[p]),
+        }
+    }
+    let b =
+        b.ok_or_else(|| Error::InvalidInput("a view of nothing: no point, face or line".into()))?;
+    if all().flatten().any(|v| !v.is_finite()) {
         return Err(Error::InvalidInput(
             "a view of non-finite coordinates".into(),
         ));
     }
-    drop(all);
     let centre = [0, 1, 2].map(|a| 0.5 * (b.min[a] + b.max[a]));
     let mut blocks = Blocks {
         html: String::new(),
