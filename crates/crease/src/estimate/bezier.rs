@@ -52,7 +52,7 @@ use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
 use super::curvature::{least_axis, monge_curvature, Curvature, Derivatives, PointCurvature};
-use crate::geometry::normal_eq::{add_outer_unit, symmetrize};
+use crate::geometry::normal_eq::{add_outer, symmetrize};
 use crate::geometry::vec3::{add, cross, dist, dist2, dot, normalize, scale, sub};
 use crate::geometry::{MeshTopology, Point3, TriMesh};
 use crate::spatial::Adjacency;
@@ -578,7 +578,7 @@ fn fit_quadric(local: &[Point3], h: f64) -> Option<Derivatives> {
     for q in local {
         let (x, y, z) = (q[0] * inv, q[1] * inv, q[2] * inv);
         let m = SVector::<f64, 6>::from([x * x, x * y, y * y, x, y, 1.0]);
-        add_outer_unit(&mut ata, &m);
+        add_outer(&mut ata, &m, 1.0);
         atb += m * z;
     }
     symmetrize(&mut ata);

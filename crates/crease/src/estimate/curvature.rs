@@ -31,7 +31,7 @@
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
-use crate::geometry::normal_eq::{add_outer_unit, symmetrize};
+use crate::geometry::normal_eq::{add_outer, symmetrize};
 use crate::geometry::vec3::{add, cross, dot, normalize, scale, sub};
 use crate::geometry::Point3;
 use crate::spatial::Neighborhoods;
@@ -356,7 +356,7 @@ pub(crate) fn fit_point(points: &[Point3], i: usize, row: &[u32]) -> PointCurvat
     let mut add_sample = |d: Point3| {
         let (x, y, z) = (dot(d, e1) * inv, dot(d, e2) * inv, dot(d, n) * inv);
         let m = SVector::<f64, 6>::from([x * x, x * y, y * y, x, y, 1.0]);
-        add_outer_unit(&mut ata, &m);
+        add_outer(&mut ata, &m, 1.0);
         atb += m * z;
     };
     add_sample([0.0; 3]);

@@ -14,13 +14,19 @@ pub struct Aabb {
 impl Aabb {
     /// The box of `points`, `None` if there are none.
     pub fn from_points(points: &[Point3]) -> Option<Aabb> {
-        let first = *points.first()?;
+        Aabb::enclosing(points.iter().copied())
+    }
+
+    /// The box of the points of an iterator, `None` if there are none.
+    pub fn enclosing(points: impl IntoIterator<Item = Point3>) -> Option<Aabb> {
+        let mut points = points.into_iter();
+        let first = points.next()?;
         let mut b = Aabb {
             min: first,
             max: first,
         };
         for p in points {
-            b.grow(*p);
+            b.grow(p);
         }
         Some(b)
     }

@@ -10,22 +10,12 @@
 use nalgebra::{SMatrix, SVector};
 
 /// `a += w g gᵀ` on the upper triangle of `a` (`j ≥ i`); call [`symmetrize`] after the last
-/// update.
+/// update. `w = 1` gives the unweighted sum exactly (`x · 1 = x` in floating point).
 #[inline]
 pub fn add_outer<const N: usize>(a: &mut SMatrix<f64, N, N>, g: &SVector<f64, N>, w: f64) {
     for j in 0..N {
         for i in 0..=j {
             a[(i, j)] += (g[i] * g[j]) * w;
-        }
-    }
-}
-
-/// `a += g gᵀ` on the upper triangle (unweighted [`add_outer`]).
-#[inline]
-pub fn add_outer_unit<const N: usize>(a: &mut SMatrix<f64, N, N>, g: &SVector<f64, N>) {
-    for j in 0..N {
-        for i in 0..=j {
-            a[(i, j)] += g[i] * g[j];
         }
     }
 }
@@ -58,7 +48,7 @@ mod tests {
             full += g * g.transpose() * w;
             add_outer(&mut half, g, w);
             full1 += g * g.transpose();
-            add_outer_unit(&mut half1, g);
+            add_outer(&mut half1, g, 1.0);
         }
         symmetrize(&mut half);
         symmetrize(&mut half1);

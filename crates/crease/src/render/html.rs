@@ -235,15 +235,8 @@ pub fn page(scene: &Scene<'_>, params: &PageParams) -> Result<String> {
             .iter()
             .chain(scene.polylines.iter().flat_map(|l| l.points.iter()))
     };
-    let mut b: Option<Aabb> = None;
-    for &p in all() {
-        match b.as_mut() {
-            Some(b) => b.grow(p),
-            None => b = Aabb::from_points(&[p]),
-        }
-    }
-    let b =
-        b.ok_or_else(|| Error::InvalidInput("a view of nothing: no point, face or line".into()))?;
+    let b = Aabb::enclosing(all().copied())
+        .ok_or_else(|| Error::InvalidInput("a view of nothing: no point, face or line".into()))?;
     if all().flatten().any(|v| !v.is_finite()) {
         return Err(Error::InvalidInput(
             "a view of non-finite coordinates".into(),
