@@ -75,6 +75,9 @@ const PART_SAMPLE: usize = 512;
 /// cylinder and a sphere, turning by 3–4°), while a fillet's strip turns by 15° and more.
 const MIN_TURN_DEGREES: f64 = 15.0;
 
+/// The quantile of [`turn`].
+const TURN_QUANTILE: f64 = 0.99;
+
 /// Fewest points of a region tried with a richer type.
 const MIN_RICHER: usize = 50;
 
@@ -134,8 +137,10 @@ impl Part {
     }
 }
 
-/// How far the normal of `s` turns over the points of `parts`: the largest angle between the
-/// normal at a point and the mean normal (90° when the normals cancel out, a closed cylinder).
+/// How far the normal of `s` turns over the points of `parts`: the [`TURN_QUANTILE`] quantile
+/// of the angles between the normal at a point and the mean normal (90° when the normals cancel
+/// out, a closed cylinder), not the largest: a few points of the neighbouring surface or of
+/// clutter left in a region must not decide its extent.
 fn turn(parts: &[&Part], s: &SurfaceParams) -> f64 {
     let s = Prepared::new(s);
     let ns: Vec<Point3> = parts
@@ -146,9 +151,14 @@ fn turn(parts: &[&Part], s: &SurfaceParams) -> f64 {
     let Some(m) = normalize(m).filter(|_| norm(m) > 0.5 * ns.len() as f64) else {
         return std::f64::consts::FRAC_PI_2;
     };
-    ns.iter()
+    let mut angles: Vec<f64> = ns
+        .iter()
         .map(|&n| dot(n, m).clamp(-1.0, 1.0).acos())
-        .fold(0.0, f64::max)
+        .collect();
+    // The 99th percentile: the largest angle is that of a few stray points.
+    let q = ((angles.len() - 1) as f64 * TURN_QUANTILE).round() as usize;
+    let (_, v, _) = angles.select_nth_unstable_by(q, f64::total_cmp);
+    *v
 }
 
 /// The fit of type `kind` to the points of `parts`; also refined from each of `starts` of that

@@ -488,6 +488,13 @@ pub(crate) fn segment_core(
             }
         })
         .collect();
+    // The points' noise, by which seeds that straddle surfaces are told apart.
+    let t = Instant::now();
+    let noise = params
+        .adapt_to_noise
+        .then(|| crate::estimate::noise::noise_sigma(points))
+        .flatten();
+    timings.push(("noise", t.elapsed().as_secs_f64()));
     let core = segment_graph(
         &GraphInput {
             graph: &graph,
@@ -498,6 +505,7 @@ pub(crate) fn segment_core(
             no_residual: &forced,
             dissolve_crease_bands: true,
             measure_noise: true,
+            noise,
             diag,
         },
         params,

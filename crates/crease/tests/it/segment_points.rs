@@ -463,3 +463,37 @@ fn noisy_rounded_cube_fillet_strips_become_cylinders_tangent_to_their_planes() {
         assert!((r - 0.1).abs() < 0.007, "fillet radius {r} for 0.1");
     }
 }
+
+/// The rounded cube at noise of a fifth of a spacing (100k points, normals estimated): its
+/// curvature labels mix faces, fillets and corners into seeds of thousands of points, whose
+/// fits (cones of half angle 45° tangent to two faces, cones around a corner's diagonal) grew
+/// over faces and fillets alike: 15 surfaces of 26, one a cone over two faces and two fillets.
+/// Seeds that their fits do not explain within three times the points' noise are now split
+/// into local patches (`segment::split_unexplained`): 18 surfaces, the 6 faces, 10 of the 12
+/// fillets with their radius, no cone.
+#[test]
+fn noisy_rounded_cube_seeds_that_straddle_surfaces_are_split() {
+    let part = common::noisy_part("rounded-cube", 100_000, 0.2);
+    let seg = segment_default(&part.cloud.positions);
+    let count = |k: SurfaceType| seg.surfaces.iter().filter(|s| s.kind == k).count();
+    let kinds: Vec<(SurfaceType, usize)> =
+        seg.surfaces.iter().map(|s| (s.kind, s.vertices)).collect();
+    eprintln!("rounded cube at 0.2 spacings: {kinds:?}");
+    assert_eq!(count(SurfaceType::Plane), 6, "{kinds:?}");
+    assert_eq!(
+        count(SurfaceType::Cone) + count(SurfaceType::Torus),
+        0,
+        "{kinds:?}"
+    );
+    let fillets = seg
+        .surfaces
+        .iter()
+        .filter(|s| match s.params {
+            crease::geometry::SurfaceParams::Cylinder { radius, .. } => {
+                (radius - 0.1).abs() < 0.007
+            }
+            _ => false,
+        })
+        .count();
+    assert!(fillets >= 10, "{fillets} fillets of radius 0.1: {kinds:?}");
+}
