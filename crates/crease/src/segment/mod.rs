@@ -765,10 +765,14 @@ pub(crate) fn segment_graph<G: Adjacency>(
     if let (Some(_), Some(noise)) = (sigma, input.noise) {
         let bound = (STRADDLING_SIGMAS * noise).max(params.th_pos * l);
         let min = params.labels.seed_size(label::TORUS);
-        let (patches, patch_fits) =
-            split_unexplained(&ctx, &seeds, &mut fitted, bound, min, |lab, vs| {
-                select_model(&ctx, lab, vs, params, min_cone, l)
-            });
+        let (patches, patch_fits) = split_unexplained(
+            &ctx,
+            &seeds,
+            &mut fitted,
+            |f| f.is_some_and(|(_, f)| f.rms > bound),
+            min,
+            |lab, vs| select_model(&ctx, lab, vs, params, min_cone, l),
+        );
         seeds.extend(patches);
         fitted.extend(patch_fits);
     }
@@ -824,21 +828,14 @@ pub(crate) fn segment_graph<G: Adjacency>(
             let explains =
                 |f: &Option<(SurfaceType, Fit)>| f.is_some_and(|(_, f)| f.rms <= tol.pos);
             if sigma.is_some() && !fitted.iter().all(explains) {
-                let (kept, split): (Vec<_>, Vec<_>) =
-                    rest.into_iter().zip(fitted).partition(|(_, f)| explains(f));
-                let patches: Vec<(u8, Vec<u32>)> = split
-                    .iter()
-                    .flat_map(|((lab, vs), _)| {
-                        labels::local_patches(vs, topo, 3 * min)
-                            .into_iter()
-                            .map(|p| (*lab, p))
-                    })
-                    .collect();
-                let patch_fits: Vec<Option<(SurfaceType, Fit)>> = patches
-                    .par_iter()
-                    .map(|(lab, vs)| select_model(&ctx, *lab, vs, params, min_cone, l))
-                    .collect();
-                (rest, fitted) = kept.into_iter().unzip();
+                let (patches, patch_fits) = split_unexplained(
+                    &ctx,
+                    &rest,
+                    &mut fitted,
+                    |f| !explains(f),
+                    min,
+                    |lab, vs| select_model(&ctx, lab, vs, params, min_cone, l),
+                );
                 rest.extend(patches);
                 fitted.extend(patch_fits);
             }
@@ -926,26 +923,26 @@ const STRADDLING_SIGMAS: f64 = 3.0;
 /// of 2–35 thousand points joining faces, fillets and corners). A fit to such a seed explains
 /// none of them, yet holds a quarter of its points and grows: a cone of half angle 45° tangent
 /// to two faces along lines swallows both faces' strips and their fillet, a cone around a
-/// corner's diagonal three fillets (14 surfaces of 26 on the rounded cube). A seed whose fit's
-/// RMS distance exceeds `bound` (three times the noise measured on the points by
-/// [`crate::estimate::noise::noise_sigma`], independent of the seeds, and at least the paper's
-/// th_pos) gives up its fit (`fitted[i] = None`); its local patches
-/// ([`labels::local_patches`], as the residual seeds' are split) are fitted with `fit` and
-/// returned, to grow in order of size with the other seeds. The noise tolerances of the
-/// growing are left as measured on the seeds (`noise_tolerance`): a depth camera's faces are
-/// warped by several times their noise, and the wider tolerances are what grow each face as
-/// one plane.
+/// corner's diagonal three fillets (14 surfaces of 26 on the rounded cube). Each seed for which
+/// `unexplained` holds (the seeds: a fit off by more than three times the noise measured on the
+/// points by [`crate::estimate::noise::noise_sigma`], independent of the seeds, and at least
+/// the paper's th_pos; the residual seeds: no fit within the position tolerance) gives up its
+/// fit (`fitted[i] = None`); its local patches of at least `3 min` vertices
+/// ([`labels::local_patches`]) are fitted with `fit` and returned for the caller to grow.
+/// The noise tolerances of the growing are left as measured on the seeds
+/// (`noise_tolerance`): a depth camera's faces are warped by several times their noise, and
+/// the wider tolerances are what grow each face as one plane.
 fn split_unexplained<G: Adjacency>(
     ctx: &grow::Ctx<G>,
     seeds: &[Seed],
     fitted: &mut [SeedFit],
-    bound: f64,
+    unexplained: impl Fn(&SeedFit) -> bool,
     min: usize,
     fit: impl Fn(u8, &[u32]) -> SeedFit + Sync,
 ) -> (Vec<Seed>, Vec<SeedFit>) {
     let mut patches: Vec<Seed> = Vec::new();
     for (i, (lab, vs)) in seeds.iter().enumerate() {
-        if fitted[i].is_some_and(|(_, f)| f.rms > bound) {
+        if unexplained(&fitted[i]) {
             fitted[i] = None;
             patches.extend(
                 labels::local_patches(vs, ctx.topo, 3 * min)
