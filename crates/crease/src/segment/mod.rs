@@ -874,7 +874,8 @@ pub(crate) fn segment_graph<G: Adjacency>(
         let t = Instant::now();
         let floor = params.simpler_floor * l;
         let richer = merge::richer_types(&ctx, &mut regions, floor, min_cone);
-        let merged = merge::merge_regions(&ctx, &mut owner, &mut regions, sigma, floor, min_cone);
+        let merged = merge::merge_regions(&ctx, &mut owner, &mut regions, sigma, floor, min_cone)
+            | merge::merge_smooth_seams(&ctx, &mut owner, &mut regions, l, floor);
         if richer || merged {
             grow::refine_borders(&ctx, &mut owner, &mut regions, 3, min_points);
         }
