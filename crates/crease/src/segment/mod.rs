@@ -874,8 +874,10 @@ pub(crate) fn segment_graph<G: Adjacency>(
         let t = Instant::now();
         let floor = params.simpler_floor * l;
         let richer = merge::richer_types(&ctx, &mut regions, floor, min_cone);
-        let merged = merge::merge_regions(&ctx, &mut owner, &mut regions, sigma, floor, min_cone)
-            | merge::merge_smooth_seams(&ctx, &mut owner, &mut regions, l, floor);
+        let merged = merge::merge_regions(&ctx, &mut owner, &mut regions, sigma, floor, min_cone);
+        // Then the planes that a scanner bent or terraced.
+        let seamed = merge::merge_smooth_seams(&ctx, &mut owner, &mut regions, l, floor);
+        let merged = merged || seamed;
         if richer || merged {
             grow::refine_borders(&ctx, &mut owner, &mut regions, 3, min_points);
         }
