@@ -898,8 +898,6 @@ pub(crate) fn segment_graph<G: Adjacency>(
         if input.dissolve_crease_bands && (richer || merged || plainer) {
             dissolve_crease_bands(input, &ctx, &mut owner, &mut explained, &mut regions);
         }
-        // Holes inside a region, within its own spread (`grow::fill_holes`).
-        grow::fill_holes(&ctx, &mut owner, &mut regions, &bez.sharp);
         timings.push(("merge", t.elapsed().as_secs_f64()));
     }
     GraphResult {

@@ -380,8 +380,7 @@ fn real_scans_are_segmented() {
 }
 
 /// A scanner bends and terraces a flat face by several times its noise; the pieces join the
-/// face they continue (`segment::merge`, step 2b: their seam is smooth), the rows of points
-/// it leaves between them fill its holes (`grow::fill_holes`). The Kinect table came
+/// face they continue (`segment::merge`, step 2b: their seam is smooth). The Kinect table came
 /// out as the table and nine pieces within a few of its RMS distances (its corners turned by
 /// 8°, patches of 14 to 2691 points one depth step off it), the CurvSurf backdrop as 8 planes.
 #[test]
@@ -416,12 +415,8 @@ fn scanner_warps_and_terraces_join_the_face_they_bend() {
             near.push((s.kind, s.vertices));
         }
     }
-    let assigned = seg.point_surface.iter().filter(|&&s| s >= 0).count() as f64 / n as f64;
-    eprintln!("table {frac:.3} of the points, {assigned:.4} assigned; pieces near it {near:?}");
+    eprintln!("table {frac:.3} of the points; pieces near it {near:?}");
     assert!(frac > 0.83, "table {frac}");
-    // The rows of points one depth step off the table, holes in it, are filled
-    // (`grow::fill_holes`): 98.4 % of the points assigned before, 99.2 % after.
-    assert!(assigned > 0.99, "assigned {assigned}");
     assert!(near.len() <= 2, "pieces of the table left apart: {near:?}");
     // The table is a plane still: its RMS distance within 3 of the noise's.
     let sigma = crease::estimate::noise::noise_sigma(pts).unwrap();
