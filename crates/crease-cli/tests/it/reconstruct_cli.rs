@@ -449,19 +449,23 @@ fn the_abc_model_becomes_a_valid_solid_with_its_fifteen_surfaces() {
 /// Real scans become valid open shells of finite faces. On the Kinect scene a thin pole's
 /// cylinder had for its only loop a straight edge from a vertex to itself, and OpenCASCADE read
 /// the face as the whole infinite cylinder: "valid", with an area of 4e98 (now the region is
-/// left out: the shell's area is 0.66 m², the table and the boxes on it).
+/// left out: the shell's area is 0.66 m², the table and the boxes on it). The CurvSurf scene
+/// falls apart into pieces (objects held above a backdrop, a patch of the backdrop beyond a
+/// gap): one shell per piece built (it was refused whole).
 #[test]
 fn real_scans_become_valid_open_shells_of_finite_faces() {
     let Some(data) = data_dir() else { return };
     let dir = tempfile::tempdir().expect("temp dir");
-    // (scan, the most area its faces may have, whether they are the box's three planes)
-    for (scan, most, box_faces) in [
-        ("scans/kinect-mosd/test0.pcd", 1.0, false),
+    // (scan, the most area its faces may have, whether they are the box's three planes, the
+    // fewest shells)
+    for (scan, most, box_faces, shells) in [
+        ("scans/kinect-mosd/test0.pcd", 1.0, false, 1),
         // A can's cylinder there had a loop going around its axis and back (written, invalid).
-        ("scans/kinect-mosd/learn33.pcd", 1.5, false),
-        ("scans/realsense-box/caixa.ply", 1.5, true),
+        ("scans/kinect-mosd/learn33.pcd", 1.5, false, 1),
+        ("scans/realsense-box/caixa.ply", 1.5, true, 1),
         // Refused while one of the box's faces, bulged by the camera, was a cone.
-        ("scans/realsense-box/caixa2.ply", 0.5, true),
+        ("scans/realsense-box/caixa2.ply", 0.5, true, 1),
+        ("scans/curvsurf/sample.xyz", 1.0, false, 2),
     ] {
         let step = dir.path().join("scan.step");
         let summary = reconstruct(&data.join(scan), &step);
@@ -469,7 +473,11 @@ fn real_scans_become_valid_open_shells_of_finite_faces() {
         let occ = check(&step, None);
         assert_eq!(occ["valid"], true, "{scan}: {occ}");
         assert_eq!(occ["closed_shells"], 0, "{scan}: {occ}");
-        assert!(faces_of(&occ) >= 3, "{scan}: {occ}");
+        assert!(
+            occ["shells"].as_u64().unwrap_or(0) >= shells,
+            "{scan}: {occ}"
+        );
+        assert!(faces_of(&occ) >= 2, "{scan}: {occ}");
         if box_faces {
             assert_eq!(
                 occ["faces"],

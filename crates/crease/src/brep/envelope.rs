@@ -46,8 +46,6 @@ pub(crate) struct Envelope {
     pub cell: f64,
     /// Components dropped (smaller than [`MIN_COMPONENT_FRACTION`] of the largest).
     pub dropped: usize,
-    /// Components kept.
-    pub pieces: usize,
 }
 
 /// The envelope of `points` (finite, non-empty; `index` built over them) dilated by `radius`,
@@ -208,14 +206,13 @@ pub(crate) fn envelope(
     let id = |k: u64| keys.binary_search(&k).map(|i| i as u32).unwrap_or(0);
     let faces: Vec<[u32; 3]> = triangles.par_iter().map(|t| t.map(id)).collect();
     let positions: Vec<Point3> = keys.par_iter().map(|&k| key_point(k)).collect();
-    let (faces, dropped, pieces) = largest_components(positions.len(), faces);
+    let (faces, dropped) = largest_components(positions.len(), faces);
     let mesh = super::compact(&positions, faces)?;
     Ok(Envelope {
         mesh,
         radius,
         cell,
         dropped,
-        pieces,
     })
 }
 
@@ -392,9 +389,8 @@ fn dilate(band: &[bool], dims: [usize; 3], axis: usize, reach: usize) -> Vec<boo
 }
 
 /// The triangles of the components (by shared vertices) holding at least
-/// [`MIN_COMPONENT_FRACTION`] of the largest one's triangles, how many were dropped and how
-/// many kept.
-fn largest_components(nv: usize, faces: Vec<[u32; 3]>) -> (Vec<[u32; 3]>, usize, usize) {
+/// [`MIN_COMPONENT_FRACTION`] of the largest one's triangles, and how many were dropped.
+fn largest_components(nv: usize, faces: Vec<[u32; 3]>) -> (Vec<[u32; 3]>, usize) {
     let mut sets = crate::geometry::union_find::UnionFind::new(nv);
     for f in &faces {
         sets.union(f[0], f[1]);
@@ -412,18 +408,13 @@ fn largest_components(nv: usize, faces: Vec<[u32; 3]>) -> (Vec<[u32; 3]>, usize,
         .enumerate()
         .filter(|&(r, &c)| c > 0 && !keep(r as u32))
         .count();
-    let pieces = count
-        .iter()
-        .enumerate()
-        .filter(|&(r, &c)| c > 0 && keep(r as u32))
-        .count();
     let faces = faces
         .into_iter()
         .zip(roots)
         .filter(|&(_, r)| keep(r))
         .map(|(f, _)| f)
         .collect();
-    (faces, dropped, pieces)
+    (faces, dropped)
 }
 
 #[cfg(test)]

@@ -29,14 +29,16 @@
 //!    reported (refused when less than [`MIN_EXPLAINED`] of the area would remain).
 //!    Unassigned triangles no surface explains (`explained_triangles`) are left out the same
 //!    way; faces falling into separate shells refuse the part;
-//! 7. output ([`step`]): a `MANIFOLD_SOLID_BREP` when every edge has a face on both sides, an
-//!    `OPEN_SHELL` (with a warning naming the border) otherwise.
+//! 7. output ([`step`]): a `MANIFOLD_SOLID_BREP` per shell when every edge has a face on both
+//!    sides, `OPEN_SHELL`s (with a warning naming the border) otherwise.
 //!
 //! A point cloud ([`reconstruct_cloud`]) goes through the shared analysis (its segmentation)
 //! and its envelope (`envelope`: the closed surface of the cloud dilated by a few spacings),
 //! whose triangles take the surfaces of the nearest samples and play the mesh's part; the
 //! residuals and tolerances are measured on the points. An open cloud (a sheet) keeps the front
-//! of its envelope.
+//! of its envelope. A cloud whose envelope falls apart into pieces (a scene's objects, a
+//! backdrop beyond a gap) is built piece by piece, one shell each (`assembly`); a piece that
+//! cannot be built is left out and reported.
 //!
 //! Not yet done (issue "scan to CAD"): a cloud's border where the samples end rather than at
 //! its envelope's rim; surfaces meeting in singular curves (two equal cylinders crossing: a
@@ -48,6 +50,7 @@
 //! chain smoothed on the surface, as a spline on it). Measured figures:
 //! `docs/experiments/brep.md`.
 
+pub(crate) mod assembly;
 pub(crate) mod envelope;
 pub(crate) mod intersect;
 pub(crate) mod pieces;
@@ -1320,7 +1323,7 @@ fn build(
         face_of_region[r] = Some(id);
     }
     let (faces, edges) = drop_empty_faces(faces, edges);
-    let shells = shells(faces.len(), &edges);
+    let shells = assembly::shells(faces.len(), &edges).len();
     if shells > 1 {
         return Err(Error::InvalidInput(format!(
             "reconstruct: the faces found form {shells} separate shells where the input is one \
@@ -1613,9 +1616,11 @@ pub const ENVELOPE_NEIGHBOUR: usize = 8;
 /// majority of the 8 nearest assigned ones). The regions the point segmentation cannot tell
 /// from their neighbours are first dissolved into them ([`snap`]), on the points. Then
 /// [`brep_from_mesh`] on the envelope, with the residuals measured on the points: every
-/// vertex and edge comes from the surfaces, none from the envelope.
+/// vertex and edge comes from the surfaces, none from the envelope. An envelope in several
+/// pieces gives a B-rep of several shells, the pieces that cannot be built left out.
 ///
-/// Errors: those of the segmentation and of [`brep_from_mesh`]; a cloud with no surface found.
+/// Errors: those of the segmentation and of [`brep_from_mesh`]; a cloud with no surface found;
+/// a cloud in pieces whose pieces built cover less than [`MIN_EXPLAINED`] of its envelope.
 pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Reconstruction> {
     use rayon::prelude::*;
     let points = analysis.points();
@@ -1660,56 +1665,6 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
         env.cell,
         env.mesh.faces.len()
     );
-    if env.pieces > 1 {
-        return Err(Error::InvalidInput(format!(
-            "reconstruct: the cloud falls apart into {} pieces (its points, widened by {:.3e}, \
-             do not join up: a gap in the sampling, or several parts); crease reconstructs one \
-             part at a time",
-            env.pieces, env.radius
-        )));
-    }
-    // A sheet (an open surface, a single-view scan): the envelope's front only.
-    let normals = analysis.normals()?;
-    let mesh = match envelope::front_side(&env.mesh, points, normals, &index) {
-        Some(keep) => {
-            let faces: Vec<[u32; 3]> = env
-                .mesh
-                .faces
-                .iter()
-                .zip(&keep)
-                .filter(|(_, &k)| k)
-                .map(|(f, _)| *f)
-                .collect();
-            compact(&env.mesh.vertices.positions, faces)?
-        }
-        None => env.mesh,
-    };
-    // Each vertex takes the majority surface of its 8 nearest assigned samples (ties: the
-    // nearest); a triangle the surface of two or three of its corners.
-    let vertex_label: Vec<i32> = mesh
-        .vertices
-        .positions
-        .par_iter()
-        .map(|q| {
-            let near = index.nearest(q, ENVELOPE_NEIGHBOUR);
-            let mut best = (0usize, -1i32);
-            for (i, &(p, _)) in near.iter().enumerate() {
-                let l = labels[p as usize];
-                if l < 0 || near[..i].iter().any(|&(o, _)| labels[o as usize] == l) {
-                    continue;
-                }
-                let votes = near
-                    .iter()
-                    .filter(|&&(o, _)| labels[o as usize] == l)
-                    .count();
-                if votes > best.0 {
-                    best = (votes, l);
-                }
-            }
-            best.1
-        })
-        .collect();
-    let face_labels = face_labels_from_vertices(&mesh.faces, &vertex_label);
     // Residuals, extents, areas and centroids on the points.
     let (stats, rms) = face_stats(
         &surfaces,
@@ -1724,7 +1679,119 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
         rms,
         border_flatness: 1.0,
     };
-    let mut rec = build_open(&mesh, &face_labels, &surfaces, Some(&fit))?;
+    let normals = analysis.normals()?;
+    // One piece of the envelope: its B-rep and its area.
+    let build_piece = |piece: TriMesh| -> (f64, Point3, Result<Reconstruction>) {
+        // A sheet (an open surface, a single-view scan): the envelope's front only.
+        let mesh = match envelope::front_side(&piece, points, normals, &index) {
+            Some(keep) => {
+                let faces: Vec<[u32; 3]> = piece
+                    .faces
+                    .iter()
+                    .zip(&keep)
+                    .filter(|(_, &k)| k)
+                    .map(|(f, _)| *f)
+                    .collect();
+                match compact(&piece.vertices.positions, faces) {
+                    Ok(m) => m,
+                    Err(e) => return (0.0, assembly::centre(&piece), Err(e)),
+                }
+            }
+            None => piece,
+        };
+        let area: f64 = face_areas(&mesh).iter().sum();
+        // Each vertex takes the majority surface of its 8 nearest assigned samples (ties: the
+        // nearest); a triangle the surface of two or three of its corners.
+        let vertex_label: Vec<i32> = mesh
+            .vertices
+            .positions
+            .par_iter()
+            .map(|q| {
+                let near = index.nearest(q, ENVELOPE_NEIGHBOUR);
+                let mut best = (0usize, -1i32);
+                for (i, &(p, _)) in near.iter().enumerate() {
+                    let l = labels[p as usize];
+                    if l < 0 || near[..i].iter().any(|&(o, _)| labels[o as usize] == l) {
+                        continue;
+                    }
+                    let votes = near
+                        .iter()
+                        .filter(|&&(o, _)| labels[o as usize] == l)
+                        .count();
+                    if votes > best.0 {
+                        best = (votes, l);
+                    }
+                }
+                best.1
+            })
+            .collect();
+        let face_labels = face_labels_from_vertices(&mesh.faces, &vertex_label);
+        let rec = build_open(&mesh, &face_labels, &surfaces, Some(&fit));
+        (area, assembly::centre(&mesh), rec)
+    };
+    let parts = pieces::components(&env.mesh);
+    let mut rec = if parts.len() == 1 {
+        build_piece(env.mesh).2?
+    } else {
+        // A cloud that falls apart (a scene's objects, a backdrop seen through a gap): each
+        // piece its own shell; those that cannot be built left out and said so.
+        let n = parts.len();
+        let (mut built, mut failed, mut total) = (Vec::new(), Vec::new(), 0.0);
+        for (k, tris) in parts.iter().enumerate() {
+            let piece = compact(
+                &env.mesh.vertices.positions,
+                tris.iter().map(|&t| env.mesh.faces[t as usize]).collect(),
+            )?;
+            let (area, at, rec) = build_piece(piece);
+            total += area;
+            match rec {
+                Ok(rec) => built.push(assembly::Piece {
+                    number: k + 1,
+                    rec,
+                    area,
+                }),
+                Err(e) => failed.push((k, area, at, e)),
+            }
+        }
+        let covered: f64 = built.iter().map(|p| p.area).sum::<f64>() / total.max(f64::MIN_POSITIVE);
+        let why = |(k, area, at, e): &(usize, f64, Point3, Error)| {
+            format!(
+                "piece {} of {n} (near ({:.4}, {:.4}, {:.4}), {:.0} % of the area): {e}",
+                k + 1,
+                at[0],
+                at[1],
+                at[2],
+                100.0 * area / total.max(f64::MIN_POSITIVE)
+            )
+        };
+        if built.is_empty() || covered < MIN_EXPLAINED {
+            return Err(Error::InvalidInput(format!(
+                "reconstruct: the cloud falls apart into {n} pieces (its points, widened by \
+                 {:.3e}, do not join up: a gap in the sampling, or several parts), and the \
+                 pieces built cover {:.0} % of it (at least {:.0} % is needed); {}",
+                env.radius,
+                100.0 * covered,
+                100.0 * MIN_EXPLAINED,
+                failed.iter().map(why).collect::<Vec<_>>().join("; ")
+            )));
+        }
+        let mut rec = assembly::assemble(built, total, n)?;
+        rec.report.warnings.insert(
+            0,
+            format!(
+                "the cloud falls apart into {n} pieces (its points, widened by {:.3e}, do not \
+                 join up): {} shells",
+                env.radius,
+                n - failed.len()
+            ),
+        );
+        rec.report.warnings.extend(
+            failed
+                .iter()
+                .map(|f| format!("{}; left out, the B-rep is open there", why(f))),
+        );
+        rec
+    };
     rec.report.snaps.splice(0..0, merges);
     rec.report.noise_ratio = analysis.noise_ratio()?;
     rec.report.segmentation = "points";
@@ -1945,17 +2012,6 @@ fn turning(
         last = Some(a);
     }
     total
-}
-
-/// The number of groups of faces joined by edges.
-fn shells(nf: usize, edges: &[BrepEdge]) -> usize {
-    let mut sets = crate::geometry::union_find::UnionFind::new(nf);
-    for e in edges {
-        if let [Some(a), Some(b)] = e.faces {
-            sets.union(a as u32, b as u32);
-        }
-    }
-    (0..nf as u32).filter(|&f| sets.find(f) == f).count()
 }
 
 /// `faces` without those left with no loop, and `edges` with their face indices renumbered.

@@ -1,7 +1,8 @@
 //! A subset of a mesh's triangles made one piece the half-edge topology can read: the largest
 //! edge-connected piece, with no vertex where it pinches (two fans of kept triangles meeting
 //! in a single vertex: the smaller fans go). Used for a sheet's front side (`envelope`) and for
-//! a part with regions left out (`super::build_open`).
+//! a part with regions left out (`super::build_open`). Also the pieces of a mesh
+//! ([`components`]), for a cloud that falls apart (`super::assembly`).
 
 use rayon::prelude::*;
 
@@ -29,6 +30,27 @@ pub(crate) fn edge_neighbours(mesh: &TriMesh) -> Vec<Vec<u32>> {
         }
     }
     neighbours
+}
+
+/// The triangles of each piece of `mesh` (triangles joined by a shared vertex), the largest
+/// first (ties: the one with the lowest triangle), each in triangle order.
+pub(crate) fn components(mesh: &TriMesh) -> Vec<Vec<u32>> {
+    let mut sets = crate::geometry::union_find::UnionFind::new(mesh.vertices.positions.len());
+    for f in &mesh.faces {
+        sets.union(f[0], f[1]);
+        sets.union(f[0], f[2]);
+    }
+    let mut piece_of_root = std::collections::HashMap::new();
+    let mut out: Vec<Vec<u32>> = Vec::new();
+    for (t, f) in mesh.faces.iter().enumerate() {
+        let p = *piece_of_root.entry(sets.find(f[0])).or_insert_with(|| {
+            out.push(Vec::new());
+            out.len() - 1
+        });
+        out[p].push(t as u32);
+    }
+    out.sort_by_key(|p| (std::cmp::Reverse(p.len()), p[0]));
+    out
 }
 
 /// The largest edge-connected piece of the flagged triangles (ties: the one with the lowest

@@ -1,6 +1,7 @@
 //! ISO 10303-21 (STEP) output of a [`Brep`]: the analytic entities of AP214
-//! (`AUTOMOTIVE_DESIGN`), as a `MANIFOLD_SOLID_BREP` when the shell is closed and a
-//! `SHELL_BASED_SURFACE_MODEL` of one `OPEN_SHELL` otherwise.
+//! (`AUTOMOTIVE_DESIGN`), one `MANIFOLD_SOLID_BREP` per shell when the shells are closed and a
+//! `SHELL_BASED_SURFACE_MODEL` of `OPEN_SHELL`s otherwise (a shell: a group of faces joined by
+//! edges; several for a cloud that fell apart into pieces).
 //!
 //! Written by hand: the Rust STEP crates looked at do not serve (truck-stepio writes only
 //! shapes built with truck's own modeller, ruststep is marked experimental), and the part of
@@ -326,15 +327,32 @@ pub fn to_step(brep: &Brep, name: &str, unit: LengthUnit, uncertainty: f64) -> S
         )));
     }
     let origin = e.placement([0.0; 3], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+    // One shell per group of faces joined by edges (a cloud that fell apart into pieces).
+    let shells: Vec<Vec<usize>> = super::assembly::shells(brep.faces.len(), &brep.edges)
+        .into_iter()
+        .map(|group| group.into_iter().map(|f| faces[f]).collect())
+        .collect();
     let representation = if brep.closed {
-        let shell = e.add(format!("CLOSED_SHELL('',({}))", refs(&faces)));
-        let solid = e.add(format!("MANIFOLD_SOLID_BREP('{name}',#{shell})"));
+        let solids: Vec<usize> = shells
+            .iter()
+            .map(|group| {
+                let shell = e.add(format!("CLOSED_SHELL('',({}))", refs(group)));
+                e.add(format!("MANIFOLD_SOLID_BREP('{name}',#{shell})"))
+            })
+            .collect();
         e.add(format!(
-            "ADVANCED_BREP_SHAPE_REPRESENTATION('{name}',(#{solid},#{origin}),#{ctx})"
+            "ADVANCED_BREP_SHAPE_REPRESENTATION('{name}',({},#{origin}),#{ctx})",
+            refs(&solids)
         ))
     } else {
-        let shell = e.add(format!("OPEN_SHELL('',({}))", refs(&faces)));
-        let model = e.add(format!("SHELL_BASED_SURFACE_MODEL('{name}',(#{shell}))"));
+        let open: Vec<usize> = shells
+            .iter()
+            .map(|group| e.add(format!("OPEN_SHELL('',({}))", refs(group))))
+            .collect();
+        let model = e.add(format!(
+            "SHELL_BASED_SURFACE_MODEL('{name}',({}))",
+            refs(&open)
+        ));
         e.add(format!(
             "MANIFOLD_SURFACE_SHAPE_REPRESENTATION('{name}',(#{model},#{origin}),#{ctx})"
         ))
