@@ -145,7 +145,16 @@ fn a_far_outlier_leaves_the_part_as_it_is() {
         pts.push([far, 0.1, 0.2]);
         let input = write_xyz(&d.join(format!("far{far:e}.xyz")), &pts);
         for (cmd, ext) in CLOUD_COMMANDS {
-            run(cmd, ext, &input);
+            let (code, err) = run(cmd, ext, &input);
+            if cmd == "reconstruct" {
+                // The envelope's grid, sized to both, is too coarse for the cube: refused,
+                // saying why, and no file.
+                assert_eq!(code, 1, "{err}");
+                assert!(err.contains("cells of the envelope's grid"), "{err}");
+                assert!(!input
+                    .with_file_name(format!("far{far:e}-reconstruct.step"))
+                    .exists());
+            }
         }
         // The cube's sharp points are those found without the outlier.
         let sharp = sharp_of(&input.with_file_name(format!("far{far:e}-sharp.ply")));

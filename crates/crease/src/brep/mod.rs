@@ -1608,6 +1608,11 @@ pub const ENVELOPE_RADIUS: f64 = 1.5;
 /// The neighbour whose distance measures the sampling for [`ENVELOPE_RADIUS`].
 pub const ENVELOPE_NEIGHBOUR: usize = 8;
 
+/// A piece of a cloud that falls apart is built when its samples span at least this many cells
+/// of the envelope's grid (sized to the whole cloud, at most `envelope::MAX_CELLS` along its
+/// box): narrower, its envelope is a blob a few cells wide that cannot carry its faces.
+pub const MIN_PIECE_CELLS: f64 = 8.0;
+
 /// The B-rep of a point cloud, from its shared analysis (segmentation, neighbours).
 ///
 /// A cloud has no triangles to read faces and edges from, so it is given some: its envelope
@@ -1742,7 +1747,23 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
                 &env.mesh.vertices.positions,
                 tris.iter().map(|&t| env.mesh.faces[t as usize]).collect(),
             )?;
-            let (area, at, rec) = build_piece(piece);
+            // A piece whose samples span a few of the grid's cells (a part beside a far
+            // outlier, the grid sized to both) has an envelope that cannot carry its faces.
+            let span = Aabb::from_points(&piece.vertices.positions).map_or(0.0, |b| {
+                (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max)
+            }) - 2.0 * env.radius;
+            let (area, at, rec) = if span < MIN_PIECE_CELLS * env.cell {
+                let area: f64 = face_areas(&piece).iter().sum();
+                let why = Error::InvalidInput(format!(
+                    "its samples span {span:.3e}, less than {MIN_PIECE_CELLS} cells of the \
+                     envelope's grid ({:.3e} each, sized to the whole cloud): too coarse to \
+                     carry its faces (a point far away from the rest?)",
+                    env.cell
+                ));
+                (area, assembly::centre(&piece), Err(why))
+            } else {
+                build_piece(piece)
+            };
             total += area;
             match rec {
                 Ok(rec) => built.push(assembly::Piece {
@@ -1753,7 +1774,7 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
                 Err(e) => failed.push((k, area, at, e)),
             }
         }
-        let covered: f64 = built.iter().map(|p| p.area).sum::<f64>() / total.max(f64::MIN_POSITIVE);
+        let covered = built.iter().fold(0.0, |a, p| a + p.area) / total.max(f64::MIN_POSITIVE);
         let why = |(k, area, at, e): &(usize, f64, Point3, Error)| {
             format!(
                 "piece {} of {n} (near ({:.4}, {:.4}, {:.4}), {:.0} % of the area): {e}",
