@@ -4,7 +4,8 @@
 //! The Riemannian graph is the symmetrised k-nearest-neighbour graph (an edge i–j when j is
 //! among the neighbours of i or i among those of j) with weight 1 − |n_i·n_j|, small between
 //! nearly parallel normals, so the tree crosses regions of high curvature last and as few times
-//! as possible. Its minimum spanning forest (Kruskal: edges sorted by (weight, i, j), union–find)
+//! as possible (an edge longer than ten times the median comes last: a far outlier's). Its
+//! minimum spanning forest (Kruskal: edges sorted by (weight, i, j), union–find)
 //! is traversed breadth-first from one seed per connected component — the point with the largest
 //! z (ties: smallest index), whose normal is turned to point +z (outward on a closed surface) —
 //! and each child normal is flipped when its dot product with its parent's is negative.
@@ -58,7 +59,7 @@ pub fn orient_normals_k(
             "orient normals: a neighbour index is out of range for {n} points"
         )));
     }
-    let tree = spanning_forest(normals, nbrs, k);
+    let tree = spanning_forest(points, normals, nbrs, k);
     let mut out = normals.to_vec();
     let mut done = vec![false; n];
     let mut queue: Vec<u32> = Vec::with_capacity(n);
@@ -91,8 +92,9 @@ pub fn orient_normals_k(
 
 /// The minimum spanning forest of the symmetrised kNN graph weighted by 1 − |n_i·n_j|, as a
 /// symmetric adjacency CSR.
-fn spanning_forest(normals: &[Point3], nbrs: &Neighborhoods, k: usize) -> Csr {
+fn spanning_forest(points: &[Point3], normals: &[Point3], nbrs: &Neighborhoods, k: usize) -> Csr {
     let n = normals.len();
+    let far = far_edge(points, nbrs, k);
     // Each undirected edge once: from i to j > i, and from i to j < i only when i is not in
     // j's row (then j's row did not produce it). Weight as f32 bits (order-preserving for
     // non-negative floats), then the endpoints: a total, deterministic order.
@@ -107,10 +109,12 @@ fn spanning_forest(normals: &[Point3], nbrs: &Neighborhoods, k: usize) -> Csr {
                 }
                 let (a, b) = if ju < i { (j, i as u32) } else { (i as u32, j) };
                 let d = vec3::dot(normals[a as usize], normals[b as usize]).abs();
-                let w = if d.is_finite() {
-                    (1.0 - d).max(0.0)
-                } else {
+                let w = if !d.is_finite() {
                     1.0
+                } else if vec3::dist(points[a as usize], points[b as usize]) > far {
+                    FAR_WEIGHT
+                } else {
+                    (1.0 - d).max(0.0)
                 };
                 Some([(w as f32).to_bits(), a, b])
             })
@@ -146,6 +150,42 @@ fn spanning_forest(normals: &[Point3], nbrs: &Neighborhoods, k: usize) -> Csr {
         fill[b as usize] += 1;
     }
     Csr { offsets, indices }
+}
+
+/// Edges longer than this many times the median edge of the graph come last in the tree
+/// ([`FAR_WEIGHT`]): a far outlier's.
+const FAR_EDGE: f64 = 10.0;
+
+/// The weight of an edge longer than [`FAR_EDGE`] times the median: above every other (at most
+/// 1). The agreement of two normals that far apart says nothing: a point 1e19 away from a cube
+/// has the cube's points for neighbours at distances equal to round-off, on any face, and the
+/// tree went through it from the top face to the bottom one, turning the bottom in (492 of a
+/// 3000-point cube's normals outward; 2998 without the point). Last, such an edge joins the
+/// tree only where nothing else does: the outlier a leaf.
+const FAR_WEIGHT: f64 = 2.0;
+
+/// [`FAR_EDGE`] times the median length of the graph's edges (infinite when that is zero or
+/// undefined).
+fn far_edge(points: &[Point3], nbrs: &Neighborhoods, k: usize) -> f64 {
+    let mut lengths: Vec<f64> = (0..points.len())
+        .into_par_iter()
+        .flat_map_iter(|i| {
+            nbrs.prefix(i, k)
+                .iter()
+                .filter(move |&&j| j as usize != i)
+                .map(move |&j| vec3::dist(points[i], points[j as usize]))
+        })
+        .collect();
+    if lengths.is_empty() {
+        return f64::INFINITY;
+    }
+    let mid = lengths.len() / 2;
+    let (_, m, _) = lengths.select_nth_unstable_by(mid, f64::total_cmp);
+    if *m > 0.0 && m.is_finite() {
+        FAR_EDGE * *m
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// One seed per connected component of `tree`: its point with the largest z (ties: smallest

@@ -295,6 +295,35 @@ fn orientation_exact_normals_two_components() {
     assert!(orient_normals(&pts, &truth[1..], &nbrs).is_err());
 }
 
+/// A point 1e19 away: its neighbours are the cube's points at distances equal to round-off,
+/// on any face, and a tree through it joined the top face to the bottom one, turning the bottom
+/// in (492 of the 3000 normals outward). Its edges now come last: the cube's normals are
+/// oriented as without it (all outward but at 2 corner points).
+#[test]
+fn orientation_ignores_a_far_outlier() {
+    let mut alone = None;
+    for far in [0.0, 1e10, 1e19] {
+        let part = sample("cube", 3_000, 0.0);
+        let mut pts = part.cloud.positions.clone();
+        let mut truth = part.cloud.normals.clone().unwrap();
+        if far > 0.0 {
+            pts.push([far, 0.1, 0.2]);
+            truth.push([0.0, 0.0, 1.0]);
+        }
+        let nbrs = knn(&pts, 20).unwrap();
+        let r = pca_normals(&pts, &nbrs, &PcaParams::default()).unwrap();
+        let o = orient_normals(&pts, &scramble(&r.normals), &nbrs).unwrap();
+        let outward = o[..3_000]
+            .iter()
+            .zip(&truth)
+            .filter(|(a, t)| vec3::dot(**a, **t) > 0.0)
+            .count();
+        let alone = *alone.get_or_insert(outward);
+        assert!(alone > 2_990, "{alone}");
+        assert_eq!(outward, alone, "outlier at {far:e}");
+    }
+}
+
 #[test]
 fn deterministic_across_thread_counts() {
     let part = sample("torus", 20_000, 0.3);
