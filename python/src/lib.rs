@@ -946,23 +946,18 @@ fn reconstruct<'py>(
         compute(py, move || {
             let start = Instant::now();
             let on_mesh = faces.as_ref().is_some_and(|f| !f.is_empty());
-            let (rec, positions) = if on_mesh {
+            let rec = if on_mesh {
                 let m = TriMesh::new(pos, faces.unwrap_or_default())?;
-                let rec = crease::brep::reconstruct_mesh(&m, &params)?;
-                (rec, m.vertices.positions)
+                crease::brep::reconstruct_mesh(&m, &params)?
             } else {
                 let analysis = AnalysisParams {
                     segment: params,
                     ..Default::default()
                 };
-                let rec = crease::brep::reconstruct_points(&pos, given.as_deref(), analysis)?;
-                (rec, pos)
+                crease::brep::reconstruct_points(&pos, given.as_deref(), analysis)?
             };
-            let size = crease::Aabb::from_points(&positions)
-                .map(|b| b.diagonal())
-                .unwrap_or(1.0);
-            let uncertainty = rec.uncertainty(size);
-            let text = rec.to_step(&name, unit, size);
+            let uncertainty = rec.uncertainty();
+            let text = rec.to_step(&name, unit);
             if let Some(o) = &out {
                 write_text(o, &text)?;
             }
@@ -1018,14 +1013,11 @@ fn run<'py>(
     d.set_item("mesh", on_mesh)?;
     let name = name.to_string();
     // The B-rep as the CLI writes it (its STEP text), or why there is none.
-    let step = move |rec: &crease::Result<crease::brep::Reconstruction>, positions: &[[f64; 3]]| {
+    let step = move |rec: &crease::Result<crease::brep::Reconstruction>| {
         rec.as_ref().map_err(|e| e.to_string()).map(|rec| {
-            let size = crease::Aabb::from_points(positions)
-                .map(|b| b.diagonal())
-                .unwrap_or(1.0);
             let report = serde_json::to_value(&rec.report).unwrap_or_default();
             (
-                rec.to_step(&name, unit, size),
+                rec.to_step(&name, unit),
                 report,
                 rec.brep.faces.len(),
                 rec.brep.edges.len(),
@@ -1037,7 +1029,7 @@ fn run<'py>(
         let (r, brep, positions) = compute(py, move || {
             let mesh = TriMesh::new(pos, faces.unwrap_or_default())?;
             let r = crease::pipeline::run_mesh(&mesh, |_| {})?;
-            let brep = step(&r.brep, &mesh.vertices.positions);
+            let brep = step(&r.brep);
             Ok((r, brep, mesh.vertices.positions))
         })?;
         let seg = &r.segmentation;
@@ -1059,7 +1051,7 @@ fn run<'py>(
         let (r, brep) = compute(py, move || {
             let analysis = CloudAnalysis::new(&pos, AnalysisParams::default())?;
             let r = crease::pipeline::run_cloud(&analysis, |_| {})?;
-            let brep = step(&r.brep, &pos);
+            let brep = step(&r.brep);
             Ok((r, brep))
         })?;
         let net = &r.network;

@@ -234,7 +234,7 @@ pub fn run(g: &Global, dir: &Path, n: usize) -> anyhow::Result<()> {
     let rec = crease::brep::reconstruct_mesh(&m.mesh, &Default::default())?;
     crate::ui::write_text(
         &dir.join("part.step"),
-        &rec.to_step("demo-part", crease::brep::LengthUnit::Millimetre, 1.0),
+        &rec.to_step("demo-part", crease::brep::LengthUnit::Millimetre),
     )?;
     time("brep", s);
 

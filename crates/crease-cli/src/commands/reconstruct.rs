@@ -83,31 +83,25 @@ pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
     let (mut geom, _) = super::load_shape(g, &a.input)?;
     let start = Instant::now();
     let stage = Stage::start("B-rep: surfaces, faces, edges, vertices", g.quiet);
-    let positions = if geom.is_mesh() {
+    let rec = if geom.is_mesh() {
         let mesh = TriMesh {
             vertices: std::mem::take(&mut geom.points),
             faces: std::mem::take(&mut geom.faces),
             face_attributes: std::mem::take(&mut geom.face_attributes),
         };
-        let rec = reconstruct_mesh(&mesh, &params);
-        (rec, mesh.vertices.positions)
+        reconstruct_mesh(&mesh, &params)
     } else {
         let analysis = AnalysisParams {
             segment: params,
             ..Default::default()
         };
-        let positions = std::mem::take(&mut geom.points.positions);
         let normals = if a.estimate_normals {
             None
         } else {
-            geom.points.normals.take()
+            geom.points.normals.as_deref()
         };
-        (
-            reconstruct_points(&positions, normals.as_deref(), analysis),
-            positions,
-        )
+        reconstruct_points(&geom.points.positions, normals, analysis)
     };
-    let (rec, positions) = positions;
     let rec = rec.with_context(|| format!("cannot build a B-rep of {}", a.input.display()))?;
     stage.finish();
     let name = a
@@ -115,13 +109,8 @@ pub fn run(g: &Global, a: &ReconstructArgs) -> anyhow::Result<()> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "part".into());
-    // The file's uncertainty: the largest gap the kernel has to close, and never below the
-    // round-off of the coordinates.
-    let size = crease::Aabb::from_points(&positions)
-        .map(|b| b.diagonal())
-        .unwrap_or(1.0);
-    let uncertainty = rec.uncertainty(size);
-    let text = rec.to_step(&name, a.units, size);
+    let uncertainty = rec.uncertainty();
+    let text = rec.to_step(&name, a.units);
     crate::ui::write_text(&a.output, &text)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
     if let Some(p) = &a.topology {

@@ -184,7 +184,7 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     super::save(g, &a.output.join("network.obj"), &net, false, &[&a.input])?;
     let surfaces = write_surfaces(&a.output, &run.surfaces, &run.groups, run.mean_edge)?;
     let points = &labels.points.positions;
-    let brep = write_brep(a, &name, points, &run.brep)?;
+    let brep = write_brep(a, &name, &run.brep)?;
 
     let sharp_lines = network.count(names::SHARP);
     let smooth_lines = network.count(names::SMOOTH);
@@ -226,27 +226,23 @@ fn run_cloud(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_js
     }))
 }
 
-/// Writes `part.step` from the B-rep of the part whose points are `points`, and returns its
+/// Writes `part.step` from the B-rep of the part, and returns its
 /// summary; a part that cannot be built is reported in the summary, not fatal (the other
 /// outputs stand).
 fn write_brep(
     a: &RunArgs,
     name: &str,
-    points: &[crease::geometry::Point3],
     rec: &crease::Result<crease::brep::Reconstruction>,
 ) -> anyhow::Result<serde_json::Value> {
     Ok(match rec {
         Ok(rec) => {
-            let size = crease::Aabb::from_points(points)
-                .map(|b| b.diagonal())
-                .unwrap_or(1.0);
             let stem = a
                 .input
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "part".into());
             let path = a.output.join("part.step");
-            crate::ui::write_text(&path, &rec.to_step(&stem, LengthUnit::Millimetre, size))
+            crate::ui::write_text(&path, &rec.to_step(&stem, LengthUnit::Millimetre))
                 .with_context(|| format!("cannot write {}", path.display()))?;
             for w in &rec.report.warnings {
                 tracing::warn!("{name}: B-rep: {w}");
@@ -276,7 +272,7 @@ fn run_mesh(g: &Global, a: &RunArgs, geom: Geometry) -> anyhow::Result<serde_jso
     progress.end();
     let run = run?;
     let seg = &run.segmentation;
-    let brep = write_brep(a, &name, &mesh.vertices.positions, &run.brep)?;
+    let brep = write_brep(a, &name, &run.brep)?;
 
     mesh.set_face_attribute(Attribute::int(
         names::SURFACE,

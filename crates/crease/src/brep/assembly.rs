@@ -125,15 +125,9 @@ pub(crate) fn assemble(pieces: Vec<Piece>, total: f64, of: usize) -> Result<Reco
             l
         }));
         let at = centre(&source.mesh);
-        r.warnings.extend(report.warnings.into_iter().map(|w| {
-            format!(
-                "piece {number} of {of} (near ({:.4}, {:.4}, {:.4}), {:.0} % of the area): {w}",
-                at[0],
-                at[1],
-                at[2],
-                100.0 * s
-            )
-        }));
+        let place = place(number, of, at, s);
+        r.warnings
+            .extend(report.warnings.into_iter().map(|w| format!("{place}: {w}")));
         // The tessellation source, renumbered; a piece walked clockwise turned over here.
         let (mv, nr) = (positions.len() as u32, out.source.regions.len() as u32);
         positions.extend_from_slice(&source.mesh.vertices.positions);
@@ -166,6 +160,17 @@ pub(crate) fn assemble(pieces: Vec<Piece>, total: f64, of: usize) -> Result<Reco
     out.report.rms_distance = (sq / weight.max(f64::MIN_POSITIVE)).sqrt();
     out.source.mesh = TriMesh::new(positions, triangles)?;
     Ok(out)
+}
+
+/// A piece named for a message: "piece `number` of `of` (near `at`, `share` of the area)".
+pub(crate) fn place(number: usize, of: usize, at: Point3, share: f64) -> String {
+    format!(
+        "piece {number} of {of} (near ({:.4}, {:.4}, {:.4}), {:.0} % of the area)",
+        at[0],
+        at[1],
+        at[2],
+        100.0 * share
+    )
 }
 
 /// The area-weighted centre of a mesh's triangles (the origin for an empty mesh).

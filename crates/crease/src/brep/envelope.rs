@@ -52,6 +52,11 @@ pub(crate) struct Envelope {
     pub cell: f64,
     /// Components dropped (smaller than [`MIN_COMPONENT_FRACTION`] of the largest).
     pub dropped: usize,
+    /// The radius and the cell asked for (before the grid was coarsened to [`MAX_CELLS`] or
+    /// [`GRID_PER_POINT`]).
+    pub base_radius: f64,
+    /// See `base_radius`.
+    pub base_cell: f64,
 }
 
 /// The envelope of `points` (finite, non-empty; `index` built over them) dilated by `radius`,
@@ -68,6 +73,7 @@ pub(crate) fn envelope(
     let longest = (0..3)
         .map(|k| bbox.max[k] - bbox.min[k])
         .fold(0.0, f64::max);
+    let (base_radius, base_cell) = (radius, cell);
     // At most MAX_CELLS along the box, and at most GRID_PER_POINT grid vertices per sample.
     let padded: f64 = (0..3)
         .map(|k| bbox.max[k] - bbox.min[k] + 2.0 * (radius + 2.0 * cell))
@@ -224,6 +230,8 @@ pub(crate) fn envelope(
         radius,
         cell,
         dropped,
+        base_radius,
+        base_cell,
     })
 }
 

@@ -453,14 +453,17 @@ struct TessellationSource {
 
 impl Reconstruction {
     /// The STEP file of the B-rep (see [`to_step`]) named `name`, in `unit`, with the
-    /// uncertainty a kernel needs to close its gaps: twice the largest gap, and never below
-    /// the round-off of coordinates of a part of diagonal `size`.
-    pub fn to_step(&self, name: &str, unit: LengthUnit, size: f64) -> String {
-        to_step(&self.brep, name, unit, self.uncertainty(size))
+    /// uncertainty a kernel needs to close its gaps (see [`Reconstruction::uncertainty`]).
+    pub fn to_step(&self, name: &str, unit: LengthUnit) -> String {
+        to_step(&self.brep, name, unit, self.uncertainty())
     }
 
-    /// The uncertainty [`Reconstruction::to_step`] writes.
-    pub fn uncertainty(&self, size: f64) -> f64 {
+    /// The uncertainty [`Reconstruction::to_step`] writes: twice the largest gap, and never
+    /// below the round-off of coordinates of the part (the diagonal of the mesh or envelope
+    /// it was built on: points left out, a stray one far away, do not count).
+    pub fn uncertainty(&self) -> f64 {
+        let size = crate::geometry::Aabb::from_points(&self.source.mesh.vertices.positions)
+            .map_or(1.0, |b| b.diagonal());
         (2.0 * self.report.max_gap).max(1e-9 * size)
     }
 
@@ -1608,9 +1611,11 @@ pub const ENVELOPE_RADIUS: f64 = 1.5;
 /// The neighbour whose distance measures the sampling for [`ENVELOPE_RADIUS`].
 pub const ENVELOPE_NEIGHBOUR: usize = 8;
 
-/// A piece of a cloud that falls apart is built when its samples span at least this many cells
-/// of the envelope's grid (sized to the whole cloud, at most `envelope::MAX_CELLS` along its
-/// box): narrower, its envelope is a blob a few cells wide that cannot carry its faces.
+/// A piece of a cloud that falls apart is built on the envelope's grid when its samples span at
+/// least this many of its cells (the grid is sized to the whole cloud, at most
+/// `envelope::MAX_CELLS` along its box): narrower, its envelope is a blob a few cells wide that
+/// cannot carry its faces, and it is made again on a grid of its own samples (a part beside a
+/// far outlier); a piece still that narrow there (the outlier) is left out.
 pub const MIN_PIECE_CELLS: f64 = 8.0;
 
 /// The B-rep of a point cloud, from its shared analysis (segmentation, neighbours).
@@ -1685,10 +1690,16 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
         border_flatness: 1.0,
     };
     let normals = analysis.normals()?;
-    // One piece of the envelope: its B-rep and its area.
-    let build_piece = |piece: TriMesh| -> (f64, Point3, Result<Reconstruction>) {
+    let all = Samples {
+        points: points.into(),
+        normals: normals.into(),
+        labels: labels.as_slice().into(),
+        index,
+    };
+    // One piece of the envelope of the samples `s`: its B-rep and its area.
+    let build_piece = |piece: TriMesh, s: &Samples| -> (f64, Point3, Result<Reconstruction>) {
         // A sheet (an open surface, a single-view scan): the envelope's front only.
-        let mesh = match envelope::front_side(&piece, points, normals, &index) {
+        let mesh = match envelope::front_side(&piece, &s.points, &s.normals, &s.index) {
             Some(keep) => {
                 let faces: Vec<[u32; 3]> = piece
                     .faces
@@ -1712,7 +1723,8 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
             .positions
             .par_iter()
             .map(|q| {
-                let near = index.nearest(q, ENVELOPE_NEIGHBOUR);
+                let near = s.index.nearest(q, ENVELOPE_NEIGHBOUR);
+                let labels = &s.labels;
                 let mut best = (0usize, -1i32);
                 for (i, &(p, _)) in near.iter().enumerate() {
                     let l = labels[p as usize];
@@ -1736,7 +1748,7 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
     };
     let parts = pieces::components(&env.mesh);
     let mut rec = if parts.len() == 1 {
-        build_piece(env.mesh).2?
+        build_piece(env.mesh, &all).2?
     } else {
         // A cloud that falls apart (a scene's objects, a backdrop seen through a gap): each
         // piece its own shell; those that cannot be built left out and said so.
@@ -1749,20 +1761,15 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
             )?;
             // A piece whose samples span a few of the grid's cells (a part beside a far
             // outlier, the grid sized to both) has an envelope that cannot carry its faces.
-            let span = Aabb::from_points(&piece.vertices.positions).map_or(0.0, |b| {
-                (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max)
-            }) - 2.0 * env.radius;
-            let (area, at, rec) = if span < MIN_PIECE_CELLS * env.cell {
-                let area: f64 = face_areas(&piece).iter().sum();
-                let why = Error::InvalidInput(format!(
-                    "its samples span {span:.3e}, less than {MIN_PIECE_CELLS} cells of the \
-                     envelope's grid ({:.3e} each, sized to the whole cloud): too coarse to \
-                     carry its faces (a point far away from the rest?)",
-                    env.cell
-                ));
-                (area, assembly::centre(&piece), Err(why))
+            // Its envelope is then made again from its samples alone (on a grid sized to
+            // them), and built when it is one piece wide enough.
+            let (area, at, rec) = if span_cells(&piece, &env) < MIN_PIECE_CELLS {
+                match finer_piece(&piece, &all, &env) {
+                    (_, Ok((finer, sub))) => build_piece(finer, &sub),
+                    (area, Err(why)) => (area, assembly::centre(&piece), Err(why)),
+                }
             } else {
-                build_piece(piece)
+                build_piece(piece, &all)
             };
             total += area;
             match rec {
@@ -1776,14 +1783,8 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
         }
         let covered = built.iter().fold(0.0, |a, p| a + p.area) / total.max(f64::MIN_POSITIVE);
         let why = |(k, area, at, e): &(usize, f64, Point3, Error)| {
-            format!(
-                "piece {} of {n} (near ({:.4}, {:.4}, {:.4}), {:.0} % of the area): {e}",
-                k + 1,
-                at[0],
-                at[1],
-                at[2],
-                100.0 * area / total.max(f64::MIN_POSITIVE)
-            )
+            let place = assembly::place(k + 1, n, *at, area / total.max(f64::MIN_POSITIVE));
+            format!("{place}: {e}")
         };
         if built.is_empty() || covered < MIN_EXPLAINED {
             return Err(Error::InvalidInput(format!(
@@ -1801,16 +1802,14 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
             0,
             format!(
                 "the cloud falls apart into {n} pieces (its points, widened by {:.3e}, do not \
-                 join up): {} shells",
+                 join up): {} built, one shell each",
                 env.radius,
                 n - failed.len()
             ),
         );
-        rec.report.warnings.extend(
-            failed
-                .iter()
-                .map(|f| format!("{}; left out, the B-rep is open there", why(f))),
-        );
+        rec.report
+            .warnings
+            .extend(failed.iter().map(|f| format!("left out {}", why(f))));
         rec
     };
     rec.report.snaps.splice(0..0, merges);
@@ -1823,6 +1822,87 @@ pub fn reconstruct_cloud(analysis: &crate::analysis::CloudAnalysis) -> Result<Re
         ));
     }
     Ok(rec)
+}
+
+/// The samples an envelope is made of: a cloud's points (or those of one of its pieces), their
+/// normals and surface labels, and an index over them.
+struct Samples<'a> {
+    points: std::borrow::Cow<'a, [Point3]>,
+    normals: std::borrow::Cow<'a, [Point3]>,
+    labels: std::borrow::Cow<'a, [i32]>,
+    index: crate::spatial::KdIndex,
+}
+
+/// How many of `env`'s grid cells the samples under a piece of it span (the piece's box less
+/// the dilation, along its longest side).
+fn span_cells(piece: &TriMesh, env: &envelope::Envelope) -> f64 {
+    let span = Aabb::from_points(&piece.vertices.positions).map_or(0.0, |b| {
+        (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max)
+    }) - 2.0 * env.radius;
+    span / env.cell
+}
+
+/// A piece of `env` (the envelope of `all`) too narrow for its grid (see [`MIN_PIECE_CELLS`]),
+/// made again from the samples in its box alone: the new envelope and those samples, with the
+/// new envelope's area (the old one's when none was made). Errors (the reason the piece is
+/// left out): the samples still span too few cells (a stray point), or they fall apart again.
+fn finer_piece(
+    piece: &TriMesh,
+    all: &Samples,
+    env: &envelope::Envelope,
+) -> (f64, Result<(TriMesh, Samples<'static>)>) {
+    let coarse = |cells: f64| {
+        Error::InvalidInput(format!(
+            "its samples span {:.1} cells of the envelope's grid (at least {MIN_PIECE_CELLS} \
+             are needed to carry its faces): a point or a cluster far from the rest?",
+            cells.max(0.0)
+        ))
+    };
+    let area = |m: &TriMesh| face_areas(m).iter().sum::<f64>();
+    let Some(bbox) = Aabb::from_points(&piece.vertices.positions) else {
+        return (0.0, Err(coarse(0.0)));
+    };
+    let ids: Vec<usize> = (0..all.points.len())
+        .filter(|&i| (0..3).all(|k| (bbox.min[k]..=bbox.max[k]).contains(&all.points[i][k])))
+        .collect();
+    let points: Vec<Point3> = ids.iter().map(|&i| all.points[i]).collect();
+    let Some(index) = crate::spatial::KdIndex::new(&points) else {
+        return (area(piece), Err(coarse(span_cells(piece, env))));
+    };
+    let finer = match envelope::envelope(&points, &index, env.base_radius, env.base_cell) {
+        Ok(f) => f,
+        Err(e) => return (area(piece), Err(e)),
+    };
+    let a = area(&finer.mesh);
+    let parts = pieces::components(&finer.mesh).len();
+    if parts > 1 {
+        return (
+            a,
+            Err(Error::InvalidInput(format!(
+                "made again from its {} samples alone, it falls apart into {parts} pieces",
+                points.len()
+            ))),
+        );
+    }
+    let cells = span_cells(&finer.mesh, &finer);
+    if cells < MIN_PIECE_CELLS {
+        return (a, Err(coarse(cells)));
+    }
+    let sub = Samples {
+        normals: ids
+            .iter()
+            .map(|&i| all.normals[i])
+            .collect::<Vec<_>>()
+            .into(),
+        labels: ids
+            .iter()
+            .map(|&i| all.labels[i])
+            .collect::<Vec<_>>()
+            .into(),
+        points: points.into(),
+        index,
+    };
+    (a, Ok((finer.mesh, sub)))
 }
 
 /// Per triangle: the label two or three of its corners share (-1 if none).
