@@ -35,10 +35,7 @@ fn run(data: &[u8]) {
     let Ok(rec) = rec else {
         return;
     };
-    let size = crease::Aabb::from_points(&mesh.vertices.positions)
-        .map(|b| b.diagonal())
-        .unwrap_or(1.0);
-    let _ = rec.uncertainty(size);
-    let _ = rec.to_step("fuzz", LengthUnit::Millimetre, size);
+    let _ = rec.uncertainty();
+    let _ = rec.to_step("fuzz", LengthUnit::Millimetre);
     let _ = rec.tessellate();
 }

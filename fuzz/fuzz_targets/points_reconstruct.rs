@@ -10,15 +10,12 @@ use crease::analysis::{AnalysisParams, CloudAnalysis};
 use crease::brep::{LengthUnit, Reconstruction};
 use crease_fuzz::Bytes;
 
-fn finish(rec: crease::Result<Reconstruction>, points: &[[f64; 3]]) {
+fn finish(rec: crease::Result<Reconstruction>) {
     let Ok(rec) = rec else {
         return;
     };
-    let size = crease::Aabb::from_points(points)
-        .map(|b| b.diagonal())
-        .unwrap_or(1.0);
-    let _ = rec.uncertainty(size);
-    let _ = rec.to_step("fuzz", LengthUnit::Millimetre, size);
+    let _ = rec.uncertainty();
+    let _ = rec.to_step("fuzz", LengthUnit::Millimetre);
     let _ = rec.tessellate();
 }
 
@@ -35,7 +32,7 @@ fn run(data: &[u8]) {
             normals.as_deref(),
             AnalysisParams::default(),
         );
-        finish(rec, &points);
+        finish(rec);
         return;
     }
     let analysis = match &normals {
@@ -53,5 +50,5 @@ fn run(data: &[u8]) {
     if let Ok(f) = crease::fillets::extract_fillets_from(&analysis, &fillets_params, true) {
         let _ = crease::fillets::curve_network(&f);
     }
-    finish(crease::brep::reconstruct_cloud(&analysis), &points);
+    finish(crease::brep::reconstruct_cloud(&analysis));
 }
