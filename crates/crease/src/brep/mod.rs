@@ -1851,6 +1851,7 @@ fn finer_piece(
     all: &Samples,
     env: &envelope::Envelope,
 ) -> (f64, Result<(TriMesh, Samples<'static>)>) {
+    use rayon::prelude::*;
     let coarse = |cells: f64| {
         Error::InvalidInput(format!(
             "its samples span {:.1} cells of the envelope's grid (at least {MIN_PIECE_CELLS} \
@@ -1863,9 +1864,11 @@ fn finer_piece(
         return (0.0, Err(coarse(0.0)));
     };
     let ids: Vec<usize> = (0..all.points.len())
+        .into_par_iter()
         .filter(|&i| (0..3).all(|k| (bbox.min[k]..=bbox.max[k]).contains(&all.points[i][k])))
         .collect();
-    let points: Vec<Point3> = ids.iter().map(|&i| all.points[i]).collect();
+    let gather = |of: &[Point3]| -> Vec<Point3> { ids.par_iter().map(|&i| of[i]).collect() };
+    let points = gather(&all.points);
     let Some(index) = crate::spatial::KdIndex::new(&points) else {
         return (area(piece), Err(coarse(span_cells(piece, env))));
     };
@@ -1889,13 +1892,9 @@ fn finer_piece(
         return (a, Err(coarse(cells)));
     }
     let sub = Samples {
-        normals: ids
-            .iter()
-            .map(|&i| all.normals[i])
-            .collect::<Vec<_>>()
-            .into(),
+        normals: gather(&all.normals).into(),
         labels: ids
-            .iter()
+            .par_iter()
             .map(|&i| all.labels[i])
             .collect::<Vec<_>>()
             .into(),
