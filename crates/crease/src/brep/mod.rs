@@ -1167,6 +1167,22 @@ fn build(
             }
         }
     }
+    // Two straight edges of one face on top of each other: the loop runs over the same
+    // stretch twice and bounds no area there (on the Kinect scene a narrow box side met the
+    // next box face along a short edge whose vertices, where the scan's border comes in, were
+    // solved onto the long edge the side shares with another face). A vertex merely touching
+    // another edge (a kernel accepts that) is not an overlap: the edge must run along it.
+    for r in 0..nr {
+        if let Some(p) = overlapping_lines(&topo.loops[r], &edges, &vertices, 0.01 * spacing) {
+            failing.push(vec![r as u32]);
+            if corner.is_none() {
+                corner = Some(format!(
+                    "near ({:.4}, {:.4}, {:.4}), two edges of a face run on top of each other",
+                    p[0], p[1], p[2]
+                ));
+            }
+        }
+    }
     // A vertex solved far from where the mesh has it: the surfaces meet, but elsewhere (two
     // nearly coaxial cylinders cross far away).
     let areas = face_areas(mesh);
@@ -2355,6 +2371,52 @@ impl Brep {
     }
 }
 
+/// Where one straight edge of a face's loops runs along another: a vertex lies within `tol`
+/// of the inside of another line edge of the face (not one of its ends) and most of the
+/// vertex's own line edge lies within `tol` of it. `None` when no line overlaps another.
+///
+/// Only lines are tested: on the Kinect scenes B-spline and conic edges of one face were
+/// found touching along a stretch too (where three surfaces nearly meet along a curve), and
+/// OpenCASCADE reads those faces as valid; leaving them out lost faces (`learn33` 17 → 15)
+/// for no gain in validity (`docs/experiments/run-profile.md`, 2026-12-07).
+fn overlapping_lines(
+    loops: &[Vec<(usize, bool)>],
+    edges: &[BrepEdge],
+    vertices: &[Point3],
+    tol: f64,
+) -> Option<Point3> {
+    let lines: Vec<&BrepEdge> = loops
+        .iter()
+        .flatten()
+        .map(|&(e, _)| &edges[e])
+        .filter(|e| matches!(e.curve, Curve::Line { .. }))
+        .collect();
+    for (i, e) in lines.iter().enumerate() {
+        let (a, b) = (vertices[e.start], vertices[e.end]);
+        for (j, f) in lines.iter().enumerate() {
+            let (c, d) = (vertices[f.start], vertices[f.end]);
+            let on_f = |p: Point3| segment_distance(p, c, d) <= tol;
+            for v in [e.start, e.end] {
+                if i == j || f.start == v || f.end == v || !on_f(vertices[v]) {
+                    continue;
+                }
+                // The share of e along f, from samples along e.
+                const SAMPLES: usize = 17;
+                let on = (0..SAMPLES)
+                    .filter(|&k| {
+                        let t = k as f64 / (SAMPLES - 1) as f64;
+                        on_f(std::array::from_fn(|c| a[c] + t * (b[c] - a[c])))
+                    })
+                    .count();
+                if 2 * on > SAMPLES {
+                    return Some(vertices[v]);
+                }
+            }
+        }
+    }
+    None
+}
+
 /// Points along an edge from its start vertex to its end vertex (a line's two vertices, a
 /// circle's arc, a B-spline's samples), the ends exactly on the vertices.
 pub fn edge_polyline(edge: &BrepEdge, vertices: &[Point3]) -> Vec<Point3> {
@@ -2516,4 +2578,46 @@ fn loop_area(l: &[(usize, bool)], edges: &[BrepEdge], vertices: &[Point3], n: Po
         }
     }
     0.5 * dot(a, n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(start: usize, end: usize) -> BrepEdge {
+        BrepEdge {
+            start,
+            end,
+            curve: Curve::Line {
+                origin: [0.0; 3],
+                dir: [1.0, 0.0, 0.0],
+            },
+            curve_sense: true,
+            faces: [Some(0), None],
+        }
+    }
+
+    #[test]
+    fn a_line_along_another_of_its_face_is_an_overlap_and_a_touch_is_not() {
+        // A square's loop 0 → 1 → 2 → 3 → 0, with vertex 4 on the bottom side (0 → 1).
+        let vertices = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.5, 0.0, 0.0],
+            [0.5, 0.5, 0.0],
+        ];
+        let tol = 1e-6;
+        // A spur 5 → 4 touching the bottom side at its middle: a touch, no overlap.
+        let edges = vec![line(0, 1), line(1, 2), line(2, 3), line(3, 0), line(5, 4)];
+        let loops = vec![(0..5).map(|e| (e, true)).collect::<Vec<_>>()];
+        assert_eq!(overlapping_lines(&loops, &edges, &vertices, tol), None);
+        // An edge 4 → 1 running along the bottom side over its second half: an overlap.
+        let edges = vec![line(0, 1), line(1, 2), line(2, 3), line(3, 0), line(4, 1)];
+        assert_eq!(
+            overlapping_lines(&loops, &edges, &vertices, tol),
+            Some([0.5, 0.0, 0.0])
+        );
+    }
 }
