@@ -255,7 +255,7 @@ pub(crate) fn front_side(
     normals: &[Point3],
     index: &KdIndex,
 ) -> Option<Vec<bool>> {
-    use crate::geometry::vec3::{dot, sub};
+    use crate::geometry::vec3::{dist2, dot, sub};
     let p = &mesh.vertices.positions;
     let in_front = |f: &[u32; 3]| {
         let c = [0, 1, 2]
@@ -278,7 +278,29 @@ pub(crate) fn front_side(
     if behind_fraction(&probe) < 0.5 * SHEET_FRACTION {
         return None;
     }
-    let mut front: Vec<bool> = mesh.faces.par_iter().map(in_front).collect();
+    // All triangles: the sample nearest each vertex, and for each triangle the one of its
+    // corners' samples nearest its centre (a vertex is shared by about six triangles: half
+    // the queries of asking at each centre, for a side test that any sample nearly as near
+    // answers alike).
+    let nearest: Vec<u32> = p.par_iter().map(|q| index.nearest_one(q).0).collect();
+    let mut front: Vec<bool> = mesh
+        .faces
+        .par_iter()
+        .map(|f| {
+            let c = [0, 1, 2]
+                .map(|k| (p[f[0] as usize][k] + p[f[1] as usize][k] + p[f[2] as usize][k]) / 3.0);
+            let i = f
+                .iter()
+                .map(|&v| nearest[v as usize] as usize)
+                .min_by(|&a, &b| {
+                    dist2(c, points[a])
+                        .total_cmp(&dist2(c, points[b]))
+                        .then(a.cmp(&b))
+                })
+                .unwrap_or(0);
+            dot(sub(c, points[i]), normals[i]) > 0.0
+        })
+        .collect();
     let n = front.len();
     if behind_fraction(&front) < SHEET_FRACTION {
         return None;
