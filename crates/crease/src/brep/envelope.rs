@@ -257,11 +257,14 @@ pub(crate) fn front_side(
 ) -> Option<Vec<bool>> {
     use crate::geometry::vec3::{dist2, dot, sub};
     let p = &mesh.vertices.positions;
+    let centre = |f: &[u32; 3]| {
+        [0, 1, 2].map(|k| (p[f[0] as usize][k] + p[f[1] as usize][k] + p[f[2] as usize][k]) / 3.0)
+    };
+    // Whether the point c lies on the side sample i's normal faces.
+    let ahead = |c: Point3, i: usize| dot(sub(c, points[i]), normals[i]) > 0.0;
     let in_front = |f: &[u32; 3]| {
-        let c = [0, 1, 2]
-            .map(|k| (p[f[0] as usize][k] + p[f[1] as usize][k] + p[f[2] as usize][k]) / 3.0);
-        let (i, _) = index.nearest_one(&c);
-        dot(sub(c, points[i as usize]), normals[i as usize]) > 0.0
+        let c = centre(f);
+        ahead(c, index.nearest_one(&c).0 as usize)
     };
     let behind_fraction = |front: &[bool]| {
         let ahead = front.iter().filter(|&&f| f).count();
@@ -287,8 +290,7 @@ pub(crate) fn front_side(
         .faces
         .par_iter()
         .map(|f| {
-            let c = [0, 1, 2]
-                .map(|k| (p[f[0] as usize][k] + p[f[1] as usize][k] + p[f[2] as usize][k]) / 3.0);
+            let c = centre(f);
             let i = f
                 .iter()
                 .map(|&v| nearest[v as usize] as usize)
@@ -298,7 +300,7 @@ pub(crate) fn front_side(
                         .then(a.cmp(&b))
                 })
                 .unwrap_or(0);
-            dot(sub(c, points[i]), normals[i]) > 0.0
+            ahead(c, i)
         })
         .collect();
     let n = front.len();

@@ -1883,8 +1883,10 @@ fn finer_piece(
         .into_par_iter()
         .filter(|&i| (0..3).all(|k| (bbox.min[k]..=bbox.max[k]).contains(&all.points[i][k])))
         .collect();
-    let gather = |of: &[Point3]| -> Vec<Point3> { ids.par_iter().map(|&i| of[i]).collect() };
-    let points = gather(&all.points);
+    fn gather<T: Copy + Send + Sync>(ids: &[usize], of: &[T]) -> Vec<T> {
+        ids.par_iter().map(|&i| of[i]).collect()
+    }
+    let points = gather(&ids, &all.points);
     let Some(index) = crate::spatial::KdIndex::new(&points) else {
         return (area(piece), Err(coarse(span_cells(piece, env))));
     };
@@ -1908,12 +1910,8 @@ fn finer_piece(
         return (a, Err(coarse(cells)));
     }
     let sub = Samples {
-        normals: gather(&all.normals).into(),
-        labels: ids
-            .par_iter()
-            .map(|&i| all.labels[i])
-            .collect::<Vec<_>>()
-            .into(),
+        normals: gather(&ids, &all.normals).into(),
+        labels: gather(&ids, &all.labels).into(),
         points: points.into(),
         index,
     };
@@ -2394,10 +2392,13 @@ fn overlapping_lines(
     for (i, e) in lines.iter().enumerate() {
         let (a, b) = (vertices[e.start], vertices[e.end]);
         for (j, f) in lines.iter().enumerate() {
+            if i == j {
+                continue;
+            }
             let (c, d) = (vertices[f.start], vertices[f.end]);
             let on_f = |p: Point3| segment_distance(p, c, d) <= tol;
             for v in [e.start, e.end] {
-                if i == j || f.start == v || f.end == v || !on_f(vertices[v]) {
+                if f.start == v || f.end == v || !on_f(vertices[v]) {
                     continue;
                 }
                 // The share of e along f, from samples along e.
