@@ -25,6 +25,15 @@
 //!    assigned, a line is noise),
 //!    at least 2 d_max edges long (shorter, Algorithm 2 of Demarsin 2007 would have pruned
 //!    them as spurs). This is what clears the meandering lines off a scan's flat faces.
+//!    Where a B-rep is anchored on, Demarsin's graph is built only on the points off its faces
+//!    and [`OFF_FACES_MARGIN`] spacings around them ([`network_off_faces`]): 12 % of a Kinect
+//!    scene, whose whole-scene Delaunay rings were most of the network's time. Departure: the
+//!    graph of a part of the cloud is not the same as that of the whole (Demarsin splits
+//!    small and large clusters by their mean size, which the part changes), so its noise
+//!    lines move. On the scans of `../shared/data` the anchored network keeps the same B-rep
+//!    edges; its lines from points are as many or fewer, with fewer free ends on the Kinect
+//!    scenes and the RealSense box, more on the CurvSurf sample (6, was 2: the open pieces of
+//!    the scan's border around the third of it its B-rep leaves out).
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -32,7 +41,8 @@ use serde::Serialize;
 use crate::analysis::CloudAnalysis;
 use crate::brep::{reconstruct_cloud, Reconstruction};
 use crate::fillets::{
-    curve_network, extract_fillets_from, CurveNetwork, FilletParams, Fillets, Label,
+    curve_network, extract_fillets_from, extract_fillets_with, CurveNetwork, FilletParams, Fillets,
+    Label,
 };
 use crate::geometry::surface::surface_normal;
 use crate::geometry::vec3::{cross, dist, dot, normalize, sub};
@@ -134,13 +144,21 @@ pub fn cloud_network(
     want_fillets: bool,
 ) -> Result<CloudNetwork> {
     let brep = reconstruct_cloud(analysis);
-    let fillets = match &brep {
-        Ok(rec) if !want_fillets && explains_all(rec) => None,
-        _ => {
-            let f = extract_fillets_from(analysis, params, true)?;
-            let net = curve_network(&f);
-            Some((f, net))
-        }
+    let whole = || -> Result<(Option<Fillets>, CurveNetwork)> {
+        let f = extract_fillets_from(analysis, params, true)?;
+        let net = curve_network(&f);
+        Ok((Some(f), net))
+    };
+    let fillets = match brep.as_ref().ok().filter(|_| !want_fillets) {
+        Some(rec) if explains_all(rec) => None,
+        // Demarsin's graph only where the B-rep leaves the cloud out; on the whole cloud if
+        // that fails (too few points there for his neighbourhoods).
+        Some(rec) if anchorable(rec).is_ok() => Some(
+            network_off_faces(analysis, rec, params)
+                .map(|off| (None, off.network))
+                .or_else(|_| whole())?,
+        ),
+        _ => Some(whole()?),
     };
     let (network, summary) = anchored(
         analysis,
@@ -150,7 +168,7 @@ pub fn cloud_network(
     )?;
     Ok(CloudNetwork {
         network,
-        fillets: fillets.map(|(f, _)| f),
+        fillets: fillets.and_then(|(f, _)| f),
         summary,
     })
 }
@@ -253,6 +271,22 @@ fn edge_group(b: &crate::brep::Brep, e: &crate::brep::BrepEdge, pts: &[Point3]) 
     }
 }
 
+/// `rec` if it explains enough of the part for lines anchored on it ([`MIN_ANCHORED`]),
+/// otherwise why not.
+pub fn anchorable(rec: &Reconstruction) -> std::result::Result<&Reconstruction, String> {
+    let left_out: f64 = rec.report.left_out.iter().map(|l| l.area_fraction).sum();
+    let explained = 1.0 - left_out - rec.report.unexplained;
+    if explained < MIN_ANCHORED {
+        Err(format!(
+            "the B-rep leaves {:.0} % of the part out (at most {:.0} % for lines anchored on it)",
+            100.0 * (1.0 - explained),
+            100.0 * (1.0 - MIN_ANCHORED)
+        ))
+    } else {
+        Ok(rec)
+    }
+}
+
 /// The network anchored on the B-rep `brep` of the cloud of `analysis` (or, when it could not
 /// be built, the reason), completed by `points_network` (Demarsin's, [`curve_network`]) where
 /// the B-rep leaves points out (its pieces of at least `2 d_max` edges); with no B-rep,
@@ -272,20 +306,7 @@ pub fn anchored(
             "network: the B-rep leaves points out, Demarsin's lines are needed there".into(),
         )
     };
-    let brep = brep.and_then(|rec| {
-        let left_out: f64 = rec.report.left_out.iter().map(|l| l.area_fraction).sum();
-        if 1.0 - left_out - rec.report.unexplained < MIN_ANCHORED {
-            Err(format!(
-                "the B-rep leaves {:.0} % of the part out (at most {:.0} % for lines anchored on \
-                 it)",
-                100.0 * (1.0 - (1.0 - left_out - rec.report.unexplained)),
-                100.0 * (1.0 - MIN_ANCHORED)
-            ))
-        } else {
-            Ok(rec)
-        }
-    });
-    let rec = match brep {
+    let rec = match brep.and_then(anchorable) {
         Ok(rec) => rec,
         Err(why) => {
             let others = points_network.ok_or_else(missing)?;
@@ -508,27 +529,158 @@ impl GroupIndex {
     }
 }
 
-/// Per vertex of `others`: whether it lies off the B-rep's faces (farther than twice the
-/// spacing, or than the tessellation's median edge, from its tessellation).
+/// The B-rep's faces, to tell how far a point lies from them: the nearest vertex of their
+/// tessellation, and the distance beyond which a point is off them (twice the spacing, or the
+/// tessellation's median edge if longer).
+struct FaceDistance {
+    index: Option<KdIndex>,
+    tol: f64,
+}
+
+impl FaceDistance {
+    fn new(rec: &Reconstruction, spacing: f64) -> Result<FaceDistance> {
+        let tess = rec.tessellation()?;
+        let verts = &tess.vertices.positions;
+        let mut edges: Vec<f64> = tess
+            .faces
+            .iter()
+            .map(|f| dist(verts[f[0] as usize], verts[f[1] as usize]))
+            .collect();
+        edges.sort_by(f64::total_cmp);
+        let median = edges.get(edges.len() / 2).copied().unwrap_or(0.0);
+        Ok(FaceDistance {
+            index: KdIndex::new(verts),
+            tol: (2.0 * spacing).max(median),
+        })
+    }
+
+    /// The distance from `p` to the nearest tessellation vertex (infinite with no faces).
+    fn distance(&self, p: &Point3) -> f64 {
+        self.index
+            .as_ref()
+            .map_or(f64::INFINITY, |ix| ix.nearest_one(p).1.sqrt())
+    }
+}
+
+/// Per vertex of `others`: whether it lies off the B-rep's faces (farther than
+/// [`FaceDistance`]'s tolerance from their tessellation).
 fn off_faces(rec: &Reconstruction, others: &CurveNetwork, spacing: f64) -> Result<Vec<bool>> {
-    let tess = rec.tessellate()?;
-    let verts = &tess.vertices.positions;
-    let mut edges: Vec<f64> = tess
-        .faces
-        .iter()
-        .map(|f| dist(verts[f[0] as usize], verts[f[1] as usize]))
-        .collect();
-    edges.sort_by(f64::total_cmp);
-    let median = edges.get(edges.len() / 2).copied().unwrap_or(0.0);
-    let tol = (2.0 * spacing).max(median);
-    let Some(faces) = KdIndex::new(verts) else {
-        return Ok(vec![true; others.vertices.len()]);
-    };
+    let faces = FaceDistance::new(rec, spacing)?;
     Ok(others
         .vertices
         .par_iter()
-        .map(|v| faces.nearest_one(v).1.sqrt() > tol)
+        .map(|v| faces.distance(v) > faces.tol)
         .collect())
+}
+
+/// Demarsin's graph where the B-rep leaves the cloud unexplained (see
+/// [`network_off_faces`]).
+#[derive(Debug)]
+pub struct OffFaces {
+    /// Per point, in the analysis' order: Demarsin's fillet label off the B-rep's faces,
+    /// [`fillet_labels`]' on them.
+    pub labels: Vec<Option<Label>>,
+    /// Demarsin's sharp and fillet lines of the points around those off the faces.
+    pub network: CurveNetwork,
+    /// How many points Demarsin's graph was built on.
+    pub points: usize,
+}
+
+/// How far around the points off a B-rep's faces Demarsin's graph is built, in spacings: his
+/// lines run where first-order regions meet, and a region needs a few rings of points on each
+/// side of a line to be told from its neighbour (the 20-neighbour Delaunay rings reach about
+/// 2.5 spacings; a line of fewer than `2 d_max` = 10 edges is dropped anyway).
+pub const OFF_FACES_MARGIN: f64 = 10.0;
+
+/// Demarsin's lines and fillet labels ([`extract_fillets_with`]) of the cloud of `analysis`
+/// only where the B-rep `rec` does not explain it: on the points off its faces and those
+/// within [`OFF_FACES_MARGIN`] spacings of them (their own neighbourhoods). A point is off the
+/// faces when its nearest vertex of their tessellation lies beyond the tolerance [`anchored`]
+/// reads lines off the faces with (twice the spacing, or the tessellation's median edge), and
+/// its own surface has no face or it lies three tolerances away (a noisy point of a face's own
+/// surface is no seed: on a Kinect scene 1 % of them lie beyond one tolerance, and dilated they
+/// cover the scene). [`anchored`] keeps of the lines only what lies off the faces and borders
+/// the regions left out, so the rest of the cloud (88 % of a Kinect scene whose B-rep leaves 4
+/// small regions out) need not pay for Delaunay rings. Labels elsewhere are
+/// [`fillet_labels`]'.
+///
+/// Errors: those of the analysis, and Demarsin's on the points off the faces (too few for
+/// his neighbourhoods, all on one line).
+pub fn network_off_faces(
+    analysis: &CloudAnalysis,
+    rec: &Reconstruction,
+    params: &FilletParams,
+) -> Result<OffFaces> {
+    let seg = analysis.segmentation()?;
+    let spacing = seg.mean_edge;
+    let faces = FaceDistance::new(rec, spacing)?;
+    let mut has_face = vec![false; seg.surfaces.len()];
+    for f in &rec.brep.faces {
+        if let Some(x) = has_face.get_mut(f.surface_id) {
+            *x = true;
+        }
+    }
+    let pts = analysis.points();
+    let away: Vec<f64> = pts.par_iter().map(|p| faces.distance(p)).collect();
+    // Off the faces: beyond the tolerance, and not a noisy point of a face's own surface.
+    let off = |i: usize| {
+        let own = usize::try_from(seg.point_surface[i])
+            .ok()
+            .is_some_and(|s| has_face.get(s).copied().unwrap_or(false));
+        away[i] > faces.tol && (!own || away[i] > 3.0 * faces.tol)
+    };
+    let seeds: Vec<Point3> = (0..pts.len()).filter(|&i| off(i)).map(|i| pts[i]).collect();
+    let mut labels = fillet_labels(analysis, rec)?;
+    let Some(seeds) = KdIndex::new(&seeds) else {
+        return Ok(OffFaces {
+            labels,
+            network: CurveNetwork::default(),
+            points: 0,
+        });
+    };
+    let reach = OFF_FACES_MARGIN * spacing;
+    let members: Vec<usize> = (0..pts.len())
+        .into_par_iter()
+        .filter(|&i| off(i) || seeds.nearest_one(&pts[i]).1 <= reach * reach)
+        .collect();
+    let sub: Vec<Point3> = members.iter().map(|&i| pts[i]).collect();
+    let nbrs = crate::spatial::knn(&sub, params.lines.k)?;
+    let mut first = crate::lines::first_order_with(&sub, &nbrs, &params.lines)?;
+    drop(nbrs);
+    // A point next to the cut (a neighbour of its, in the whole cloud, left out of the
+    // subset) has a one-sided ring, but it is no border of the scan.
+    let mut member = vec![false; pts.len()];
+    for &i in &members {
+        member[i] = true;
+    }
+    let nbrs = analysis.neighbours()?;
+    let k = params.lines.k.min(nbrs.k());
+    for (b, &i) in first.boundary.iter_mut().zip(&members) {
+        if nbrs.prefix(i, k).iter().any(|&j| !member[j as usize]) {
+            *b = false;
+        }
+    }
+    let f = extract_fillets_with(&sub, &first, params, true)?;
+    for (&i, &l) in members.iter().zip(&f.label) {
+        if off(i) {
+            labels[i] = l;
+        }
+    }
+    // The lines within half the margin of a point off the faces: nearer the subset's cut, its
+    // points' rings are one-sided and Demarsin's regions break along the cut.
+    let lines = curve_network(&f);
+    let keep: Vec<bool> = lines
+        .vertices
+        .par_iter()
+        .map(|v| seeds.nearest_one(v).1 <= 0.25 * reach * reach)
+        .collect();
+    let mut network = CurveNetwork::default();
+    add_pieces(&mut network, &lines, &keep, 1);
+    Ok(OffFaces {
+        labels,
+        network,
+        points: sub.len(),
+    })
 }
 
 /// Per vertex of `others`: whether it is not inside one surface of the segmentation (see the

@@ -25,7 +25,9 @@ use crate::brep::{reconstruct_cloud, reconstruct_segmented_mesh, Reconstruction}
 use crate::fillets::{curve_network, extract_fillets_from, CurveNetwork, FilletParams, Label};
 use crate::geometry::TriMesh;
 use crate::meshfeat::{detect_edges, feature_polylines, EdgeDetection, EdgeParams};
-use crate::network::{anchored, explains_all, fillet_labels, NetworkSummary};
+use crate::network::{
+    anchorable, anchored, explains_all, fillet_labels, network_off_faces, NetworkSummary,
+};
 use crate::segment::recognize::Group;
 use crate::segment::{segment_mesh, SegmentParams, SegmentSurface, Segmentation};
 use crate::sharp::{detect, SharpParams, SharpResult};
@@ -137,6 +139,15 @@ pub fn run_cloud(analysis: &CloudAnalysis, stage: impl FnMut(Stage)) -> Result<C
             let labels = analysis.to_input_order(&fillet_labels(analysis, rec)?);
             let (net, summary) = anchored(analysis, Ok(rec), None, params.lines.d_max)?;
             return Ok((labels, net, summary));
+        }
+        if let Some(rec) = brep.as_ref().ok().filter(|rec| anchorable(rec).is_ok()) {
+            // Demarsin's graph only where the B-rep leaves the cloud out (on the whole cloud
+            // below if that fails: too few points there for his neighbourhoods).
+            if let Ok(off) = network_off_faces(analysis, rec, &params) {
+                let (net, summary) =
+                    anchored(analysis, Ok(rec), Some(&off.network), params.lines.d_max)?;
+                return Ok((analysis.to_input_order(&off.labels), net, summary));
+            }
         }
         let f = extract_fillets_from(analysis, &params, true)?;
         let points_network = curve_network(&f);

@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use crate::geometry::{Point3, TriMesh};
 use crate::Result;
 
-use super::{BrepEdge, Reconstruction, TessellationSource};
+use super::{BrepEdge, Reconstruction, TessellationCache, TessellationSource};
 
 /// A piece built, with its envelope's area.
 pub(crate) struct Piece {
@@ -55,6 +55,7 @@ pub(crate) fn assemble(pieces: Vec<Piece>, total: f64, of: usize) -> Result<Reco
     out.brep.edges.clear();
     out.brep.faces.clear();
     out.brep.closed = true;
+    out.tessellation = TessellationCache::default();
     out.source = TessellationSource {
         mesh: TriMesh::new(Vec::new(), Vec::new())?,
         region_of_face: Vec::new(),
@@ -75,6 +76,7 @@ pub(crate) fn assemble(pieces: Vec<Piece>, total: f64, of: usize) -> Result<Reco
             brep,
             report,
             source,
+            ..
         } = piece.rec;
         // The B-rep, renumbered.
         let (nv, ne, nf) = (

@@ -430,6 +430,21 @@ pub struct Reconstruction {
     /// What [`Reconstruction::tessellate`] needs of the mesh the B-rep was read from.
     #[serde(skip)]
     source: TessellationSource,
+    /// The tessellation, once made.
+    #[serde(skip)]
+    tessellation: TessellationCache,
+}
+
+/// [`Reconstruction::tessellation`] once made: the curve network, the report's picture and
+/// the `--mesh` output each read it. Not part of a reconstruction's value (equal whether made
+/// or not).
+#[derive(Debug, Clone, Default)]
+struct TessellationCache(std::sync::OnceLock<TriMesh>);
+
+impl PartialEq for TessellationCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// What the tessellation of a B-rep needs of the mesh (or envelope) it was read from, kept so
@@ -474,7 +489,16 @@ impl Reconstruction {
     /// edge share its vertices; per triangle its face (`face`) and surface type
     /// (`surface_type`) as attributes.
     pub fn tessellate(&self) -> Result<TriMesh> {
-        tessellate(&self.source, &self.brep)
+        self.tessellation().cloned()
+    }
+
+    /// [`Reconstruction::tessellate`] without the copy, made once and kept.
+    pub fn tessellation(&self) -> Result<&TriMesh> {
+        if let Some(mesh) = self.tessellation.0.get() {
+            return Ok(mesh);
+        }
+        let mesh = tessellate(&self.source, &self.brep)?;
+        Ok(self.tessellation.0.get_or_init(|| mesh))
     }
 }
 
@@ -1407,6 +1431,7 @@ fn build(
         brep,
         report,
         source,
+        tessellation: TessellationCache::default(),
     })
 }
 
