@@ -127,27 +127,52 @@ pub(crate) fn envelope(
         .collect();
     drop(band);
 
-    // Outside: reachable from the grid's border through f > 0 (6-connected).
+    // Outside: reachable from the grid's border through f > 0 (6-connected). The border's
+    // vertices are marked first; the search then walks inner vertices only, whose six
+    // neighbours are all in the grid (index steps, no bounds to test).
     let mut outside = vec![false; n];
-    let mut stack: Vec<usize> = Vec::new();
-    for v in 0..n {
+    let on_border = |v: usize| {
         let c = coords(v);
-        let border = (0..3).any(|k| c[k] == 0 || c[k] == dims[k] - 1);
-        if border && field[v] > 0.0 {
+        (0..3).any(|k| c[k] == 0 || c[k] == dims[k] - 1)
+    };
+    let mut border: Vec<usize> = Vec::new();
+    for k in 0..nz {
+        for j in 0..ny {
+            let row = at(0, j, k);
+            if k == 0 || k == nz - 1 || j == 0 || j == ny - 1 {
+                border.extend(row..row + nx);
+            } else {
+                border.push(row);
+                border.push(row + nx - 1);
+            }
+        }
+    }
+    for &v in &border {
+        if field[v] > 0.0 {
             outside[v] = true;
-            stack.push(v);
+        }
+    }
+    let steps = [1, nx, nx * ny];
+    let mut stack: Vec<usize> = Vec::new();
+    for &v in &border {
+        if !outside[v] {
+            continue;
+        }
+        let c = coords(v);
+        for (k, &step) in steps.iter().enumerate() {
+            let below = (c[k] > 0).then(|| v - step);
+            let above = (c[k] + 1 < dims[k]).then_some(v + step);
+            for w in below.into_iter().chain(above) {
+                if !on_border(w) && !outside[w] && field[w] > 0.0 {
+                    outside[w] = true;
+                    stack.push(w);
+                }
+            }
         }
     }
     while let Some(v) = stack.pop() {
-        let c = coords(v);
-        for k in 0..3 {
-            for up in [false, true] {
-                if (!up && c[k] == 0) || (up && c[k] + 1 == dims[k]) {
-                    continue;
-                }
-                let mut d = c;
-                d[k] = if up { c[k] + 1 } else { c[k] - 1 };
-                let w = at(d[0], d[1], d[2]);
+        for &step in &steps {
+            for w in [v - step, v + step] {
                 if !outside[w] && field[w] > 0.0 {
                     outside[w] = true;
                     stack.push(w);
@@ -314,8 +339,9 @@ pub(crate) fn front_side(
         front = (0..n)
             .into_par_iter()
             .map(|t| {
-                let votes = neighbours[t].iter().filter(|&&u| front[u as usize]).count();
-                match (2 * votes).cmp(&neighbours[t].len()) {
+                let around = neighbours.row(t);
+                let votes = around.iter().filter(|&&u| front[u as usize]).count();
+                match (2 * votes).cmp(&around.len()) {
                     std::cmp::Ordering::Greater => true,
                     std::cmp::Ordering::Less => false,
                     std::cmp::Ordering::Equal => front[t],

@@ -726,7 +726,7 @@ fn explained_triangles(
     mesh: &TriMesh,
     face_surface: &[i32],
     surfaces: &[SurfaceParams],
-    neighbours: &[Vec<u32>],
+    neighbours: &crate::geometry::Csr,
 ) -> Vec<bool> {
     let p = &mesh.vertices.positions;
     let (mut sq, mut count) = (0.0, 0usize);
@@ -747,7 +747,7 @@ fn explained_triangles(
         let mut claims: Vec<(u32, i32)> = Vec::new();
         for &t in &frontier {
             let l = label[t as usize];
-            for &u in &neighbours[t as usize] {
+            for &u in neighbours.row(t as usize) {
                 if label[u as usize] >= 0 {
                     continue;
                 }

@@ -6,10 +6,10 @@
 
 use rayon::prelude::*;
 
-use crate::geometry::TriMesh;
+use crate::geometry::{Csr, TriMesh};
 
-/// Per triangle: the triangles that share an edge with it.
-pub(crate) fn edge_neighbours(mesh: &TriMesh) -> Vec<Vec<u32>> {
+/// Per triangle (row): the triangles that share an edge with it.
+pub(crate) fn edge_neighbours(mesh: &TriMesh) -> Csr {
     let mut by_edge: Vec<(u32, u32, u32)> = mesh
         .faces
         .iter()
@@ -22,14 +22,27 @@ pub(crate) fn edge_neighbours(mesh: &TriMesh) -> Vec<Vec<u32>> {
         })
         .collect();
     by_edge.par_sort_unstable();
-    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); mesh.faces.len()];
-    for w in by_edge.windows(2) {
-        if (w[0].0, w[0].1) == (w[1].0, w[1].1) {
-            neighbours[w[0].2 as usize].push(w[1].2);
-            neighbours[w[1].2 as usize].push(w[0].2);
-        }
+    let pairs = || {
+        by_edge
+            .windows(2)
+            .filter(|w| (w[0].0, w[0].1) == (w[1].0, w[1].1))
+            .map(|w| (w[0].2, w[1].2))
+    };
+    let mut counts = vec![0u32; mesh.faces.len()];
+    for (a, b) in pairs() {
+        counts[a as usize] += 1;
+        counts[b as usize] += 1;
     }
-    neighbours
+    let offsets = Csr::offsets_from_counts(&counts);
+    let mut next: Vec<u32> = offsets[..counts.len()].to_vec();
+    let mut indices = vec![0u32; offsets[counts.len()] as usize];
+    for (a, b) in pairs() {
+        indices[next[a as usize] as usize] = b;
+        next[a as usize] += 1;
+        indices[next[b as usize] as usize] = a;
+        next[b as usize] += 1;
+    }
+    Csr { offsets, indices }
 }
 
 /// The triangles of each piece of `mesh` (triangles joined by a shared vertex), the largest
@@ -55,7 +68,7 @@ pub(crate) fn components(mesh: &TriMesh) -> Vec<Vec<u32>> {
 
 /// The largest edge-connected piece of the flagged triangles (ties: the one with the lowest
 /// triangle), or none when no triangle is flagged.
-pub(crate) fn largest_piece(flag: &[bool], neighbours: &[Vec<u32>]) -> Option<Vec<bool>> {
+pub(crate) fn largest_piece(flag: &[bool], neighbours: &Csr) -> Option<Vec<bool>> {
     let n = flag.len();
     let mut piece = vec![u32::MAX; n];
     let mut sizes = Vec::new();
@@ -69,7 +82,7 @@ pub(crate) fn largest_piece(flag: &[bool], neighbours: &[Vec<u32>]) -> Option<Ve
         let mut size = 0usize;
         while let Some(u) = stack.pop() {
             size += 1;
-            for &v in &neighbours[u] {
+            for &v in neighbours.row(u) {
                 if flag[v as usize] && piece[v as usize] == u32::MAX {
                     piece[v as usize] = id;
                     stack.push(v as usize);
@@ -84,34 +97,46 @@ pub(crate) fn largest_piece(flag: &[bool], neighbours: &[Vec<u32>]) -> Option<Ve
 
 /// The largest piece of the flagged triangles with no pinched vertex (see the module doc), or
 /// none when no triangle is flagged.
-pub(crate) fn manifold_piece(
-    mesh: &TriMesh,
-    flag: &[bool],
-    neighbours: &[Vec<u32>],
-) -> Option<Vec<bool>> {
+pub(crate) fn manifold_piece(mesh: &TriMesh, flag: &[bool], neighbours: &Csr) -> Option<Vec<bool>> {
     let mut keep = largest_piece(flag, neighbours)?;
-    let mut around: Vec<Vec<u32>> = vec![Vec::new(); mesh.vertices.positions.len()];
-    for (t, f) in mesh.faces.iter().enumerate() {
+    // Per vertex (row): its triangles.
+    let mut counts = vec![0u32; mesh.vertices.positions.len()];
+    for f in &mesh.faces {
         for &v in f {
-            around[v as usize].push(t as u32);
+            counts[v as usize] += 1;
         }
     }
+    let offsets = Csr::offsets_from_counts(&counts);
+    let mut next: Vec<u32> = offsets[..counts.len()].to_vec();
+    let mut indices = vec![0u32; offsets[counts.len()] as usize];
+    for (t, f) in mesh.faces.iter().enumerate() {
+        for &v in f {
+            indices[next[v as usize] as usize] = t as u32;
+            next[v as usize] += 1;
+        }
+    }
+    let around = Csr { offsets, indices };
+    let (mut kept, mut fan, mut sizes, mut stack) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for _ in 0..4 {
         let mut changed = false;
-        for (v, tris) in around.iter().enumerate() {
-            let kept: Vec<u32> = tris.iter().copied().filter(|&t| keep[t as usize]).collect();
+        for (v, tris) in around.rows().enumerate() {
+            kept.clear();
+            kept.extend(tris.iter().copied().filter(|&t| keep[t as usize]));
             if kept.len() < 2 {
                 continue;
             }
             // Fans: kept triangles about v joined across an edge through v.
-            let mut fan = vec![usize::MAX; kept.len()];
-            let mut sizes = Vec::new();
+            fan.clear();
+            fan.resize(kept.len(), usize::MAX);
+            sizes.clear();
             for i in 0..kept.len() {
                 if fan[i] != usize::MAX {
                     continue;
                 }
                 fan[i] = sizes.len();
-                let mut stack = vec![i];
+                stack.clear();
+                stack.push(i);
                 let mut size = 0;
                 while let Some(a) = stack.pop() {
                     size += 1;
