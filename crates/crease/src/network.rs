@@ -30,10 +30,10 @@
 //!    scene, whose whole-scene Delaunay rings were most of the network's time. Departure: the
 //!    graph of a part of the cloud is not the same as that of the whole (Demarsin splits
 //!    small and large clusters by their mean size, which the part changes), so its noise
-//!    lines move. On the scans of `../shared/data` the anchored network keeps the same B-rep
-//!    edges; its lines from points are as many or fewer, with fewer free ends on the Kinect
-//!    scenes and the RealSense box, more on the CurvSurf sample (6, was 2: the open pieces of
-//!    the scan's border around the third of it its B-rep leaves out).
+//!    lines move. On the scans of `../shared/data` the network's free ends went 2 → 0 (Kinect
+//!    test0), 28 → 25 (learn33), 6 → 4 (RealSense box), but 3 → 5 (test16) and 2 → 6 (the
+//!    CurvSurf sample, whose scan border around the third its B-rep leaves out now comes in
+//!    open pieces); see `docs/experiments/run-profile.md`.
 
 use rayon::prelude::*;
 use serde::Serialize;
