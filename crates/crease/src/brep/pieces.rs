@@ -22,25 +22,27 @@ pub(crate) fn edge_neighbours(mesh: &TriMesh) -> Csr {
         })
         .collect();
     by_edge.par_sort_unstable();
-    let pairs = || {
+    rows_of(mesh.faces.len(), || {
         by_edge
             .windows(2)
             .filter(|w| (w[0].0, w[0].1) == (w[1].0, w[1].1))
-            .map(|w| (w[0].2, w[1].2))
-    };
-    let mut counts = vec![0u32; mesh.faces.len()];
-    for (a, b) in pairs() {
-        counts[a as usize] += 1;
-        counts[b as usize] += 1;
+            .flat_map(|w| [(w[0].2, w[1].2), (w[1].2, w[0].2)])
+    })
+}
+
+/// The CSR rows of `rows` rows holding the `(row, entry)` pairs that `entries` yields (called
+/// twice: to count, then to fill), each row in the order they come.
+fn rows_of<I: Iterator<Item = (u32, u32)>>(rows: usize, entries: impl Fn() -> I) -> Csr {
+    let mut counts = vec![0u32; rows];
+    for (r, _) in entries() {
+        counts[r as usize] += 1;
     }
     let offsets = Csr::offsets_from_counts(&counts);
-    let mut next: Vec<u32> = offsets[..counts.len()].to_vec();
-    let mut indices = vec![0u32; offsets[counts.len()] as usize];
-    for (a, b) in pairs() {
-        indices[next[a as usize] as usize] = b;
-        next[a as usize] += 1;
-        indices[next[b as usize] as usize] = a;
-        next[b as usize] += 1;
+    let mut next: Vec<u32> = offsets[..rows].to_vec();
+    let mut indices = vec![0u32; offsets[rows] as usize];
+    for (r, e) in entries() {
+        indices[next[r as usize] as usize] = e;
+        next[r as usize] += 1;
     }
     Csr { offsets, indices }
 }
@@ -100,22 +102,12 @@ pub(crate) fn largest_piece(flag: &[bool], neighbours: &Csr) -> Option<Vec<bool>
 pub(crate) fn manifold_piece(mesh: &TriMesh, flag: &[bool], neighbours: &Csr) -> Option<Vec<bool>> {
     let mut keep = largest_piece(flag, neighbours)?;
     // Per vertex (row): its triangles.
-    let mut counts = vec![0u32; mesh.vertices.positions.len()];
-    for f in &mesh.faces {
-        for &v in f {
-            counts[v as usize] += 1;
-        }
-    }
-    let offsets = Csr::offsets_from_counts(&counts);
-    let mut next: Vec<u32> = offsets[..counts.len()].to_vec();
-    let mut indices = vec![0u32; offsets[counts.len()] as usize];
-    for (t, f) in mesh.faces.iter().enumerate() {
-        for &v in f {
-            indices[next[v as usize] as usize] = t as u32;
-            next[v as usize] += 1;
-        }
-    }
-    let around = Csr { offsets, indices };
+    let around = rows_of(mesh.vertices.positions.len(), || {
+        mesh.faces
+            .iter()
+            .enumerate()
+            .flat_map(|(t, f)| f.map(|v| (v, t as u32)))
+    });
     let (mut kept, mut fan, mut sizes, mut stack) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for _ in 0..4 {
