@@ -109,14 +109,34 @@ pub fn regularize(
     sharpness: &[f64],
     params: &Regularize,
 ) -> Result<Vec<bool>> {
+    regularize_fixed(points, nbrs, sharpness, params, None)
+}
+
+/// [`regularize`] with some labels known beforehand (`fixed[i] = Some(label)`, e.g. the points
+/// the analytic surfaces decide, see [`super::surfaces`]): the minimum over the other labels,
+/// the fixed ones entering their neighbours' terms as constants. The cut's graph holds only the
+/// free points, so a cloud the surfaces decide almost everywhere costs little. The fixed
+/// points' labels are returned as given.
+///
+/// Errors: as [`regularize`], and `fixed` of another length.
+pub(crate) fn regularize_fixed(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    sharpness: &[f64],
+    params: &Regularize,
+    fixed: Option<&[Option<bool>]>,
+) -> Result<Vec<bool>> {
     let n = points.len();
-    if sharpness.len() != n || nbrs.len() != n {
+    if sharpness.len() != n || nbrs.len() != n || fixed.is_some_and(|f| f.len() != n) {
         return Err(Error::InvalidArgument(format!(
-            "sharp regularisation: {} sharpness values, {} neighbour lists for {n} points",
+            "sharp regularisation: {} sharpness values, {} neighbour lists, {} fixed labels \
+             for {n} points",
             sharpness.len(),
-            nbrs.len()
+            nbrs.len(),
+            fixed.map_or(n, <[_]>::len)
         )));
     }
+    let fixed_at = |i: usize| fixed.and_then(|f| f[i]);
     params.validate()?;
     let k = params.k;
     if k > nbrs.k() || params.k_dir > nbrs.k() {
@@ -155,12 +175,46 @@ pub fn regularize(
             1.0
         }
     };
-    // Line direction and linearity per point (only needed with a line reward).
+    // Undirected kNN edges, those with a free end only.
+    let mut offsets = Vec::with_capacity(n + 1);
+    let mut indices = Vec::with_capacity(n * k);
+    offsets.push(0u32);
+    for i in 0..n {
+        indices.extend_from_slice(nbrs.prefix(i, k));
+        offsets.push(indices.len() as u32);
+    }
+    let graph = crate::geometry::Csr { offsets, indices };
+    let all_edges = crate::graphcut::undirected_edges(&graph);
+    drop(graph);
+    let g_all: Vec<f64> = all_edges
+        .par_iter()
+        .map(|&(i, j)| gauss(i as usize, j as usize))
+        .collect();
+    // W: the mean over all the points, fixed or not, of Σ_j exp(…) (summed in order: the
+    // same whatever the thread count).
+    let norm = 2.0 * g_all.iter().sum::<f64>() / n.max(1) as f64;
+    let norm = if norm > 0.0 { norm } else { 1.0 };
+    let edges: Vec<((u32, u32), f64)> = all_edges
+        .into_iter()
+        .zip(g_all)
+        .filter(|&((i, j), _)| fixed_at(i as usize).is_none() || fixed_at(j as usize).is_none())
+        .collect();
+    // Line direction and linearity per point at an edge (only needed with a line reward).
+    let mut at_edge = vec![fixed.is_none(); n];
+    if fixed.is_some() {
+        for &((i, j), _) in &edges {
+            at_edge[i as usize] = true;
+            at_edge[j as usize] = true;
+        }
+    }
     let dirs: Vec<(Point3, f64)> = if params.line_reward > 0.0 {
         (0..n)
             .into_par_iter()
             .with_min_len(256)
             .map(|i| {
+                if !at_edge[i] {
+                    return ([0.0; 3], 0.0);
+                }
                 let prob = |j: usize| 1.0 / (1.0 + (-params.slope * log_s[j]).exp());
                 let items = std::iter::once(i as u32)
                     .chain(nbrs.prefix(i, params.k_dir).iter().copied())
@@ -176,29 +230,31 @@ pub fn regularize(
     } else {
         Vec::new()
     };
-    // Undirected kNN edges with their weights.
-    let mut offsets = Vec::with_capacity(n + 1);
-    let mut indices = Vec::with_capacity(n * k);
-    offsets.push(0u32);
-    for i in 0..n {
-        indices.extend_from_slice(nbrs.prefix(i, k));
-        offsets.push(indices.len() as u32);
-    }
-    let graph = crate::geometry::Csr { offsets, indices };
-    let edges = crate::graphcut::undirected_edges(&graph);
-    let g_sum: Vec<f64> = edges
-        .par_iter()
-        .map(|&(i, j)| gauss(i as usize, j as usize))
-        .collect();
-    let norm = 2.0 * g_sum.iter().sum::<f64>() / n.max(1) as f64;
-    let norm = if norm > 0.0 { norm } else { 1.0 };
-    let mut e = BinaryEnergy::with_capacity(n, edges.len());
+    // The cut's nodes: the free points, numbered in order.
+    let node: Vec<u32> = {
+        let mut next = 0u32;
+        (0..n)
+            .map(|i| {
+                if fixed_at(i).is_some() {
+                    u32::MAX
+                } else {
+                    next += 1;
+                    next - 1
+                }
+            })
+            .collect()
+    };
+    let free = node.iter().filter(|&&v| v != u32::MAX).count();
+    let mut e = BinaryEnergy::with_capacity(free, edges.len());
     for (i, &l) in log_s.iter().enumerate() {
+        if node[i] == u32::MAX {
+            continue;
+        }
         let d = params.slope * l;
         // D(0) − D(1) = slope · ln(sharpness).
-        e.add_unary(i, d.max(0.0), (-d).max(0.0))?;
+        e.add_unary(node[i] as usize, d.max(0.0), (-d).max(0.0))?;
     }
-    for (&(i, j), &g) in edges.iter().zip(&g_sum) {
+    for &((i, j), g) in &edges {
         let (i, j) = (i as usize, j as usize);
         let w = g / norm;
         let potts = params.lambda * w;
@@ -216,17 +272,34 @@ pub fn regularize(
         } else {
             0.0
         };
-        if reward > 0.0 {
-            e.add_pairwise(i, j, 0.0, potts, potts, -reward)?;
-        } else if potts > 0.0 {
-            e.add_potts(i, j, potts)?;
+        // V(x_i, x_j): 0, potts, potts, −reward.
+        let v = |a: bool, b: bool| match (a, b) {
+            (false, false) => 0.0,
+            (true, true) => -reward,
+            _ => potts,
+        };
+        match (fixed_at(i), fixed_at(j)) {
+            (None, None) => {
+                let (a, b) = (node[i] as usize, node[j] as usize);
+                if reward > 0.0 {
+                    e.add_pairwise(a, b, 0.0, potts, potts, -reward)?;
+                } else if potts > 0.0 {
+                    e.add_potts(a, b, potts)?;
+                }
+            }
+            (None, Some(lj)) => e.add_unary(node[i] as usize, v(false, lj), v(true, lj))?,
+            (Some(li), None) => e.add_unary(node[j] as usize, v(li, false), v(li, true))?,
+            (Some(_), Some(_)) => {}
         }
     }
     // The cut's graph is the largest allocation of the sharp stage on a noisy cloud: the
     // inputs it was built from go first (a fifth of the peak of `crease run` on a million
     // noisy points).
-    drop((graph, edges, g_sum, dirs, h, log_s));
-    Ok(e.minimize().labels)
+    drop((edges, dirs, h, log_s, at_edge));
+    let cut = e.minimize().labels;
+    Ok((0..n)
+        .map(|i| fixed_at(i).unwrap_or_else(|| cut[node[i] as usize]))
+        .collect())
 }
 
 #[cfg(test)]
@@ -283,5 +356,55 @@ mod tests {
         };
         assert!(regularize(&points, &nbrs, &sharpness, &bad).is_err());
         assert!(regularize(&points, &nbrs, &sharpness[1..], &params).is_err());
+    }
+
+    /// Fixing some labels to those of the whole minimum leaves the others at it (a better
+    /// labelling of the free points would lower the whole energy), and the fixed labels are
+    /// returned as given, even against their data.
+    #[test]
+    fn fixed_labels_keep_the_minimum_of_the_others() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        let w = 40usize;
+        let points: Vec<Point3> = (0..w * w)
+            .map(|i| {
+                let (x, y) = ((i % w) as f64, (i / w) as f64);
+                [
+                    x + rng.random_range(-0.2..0.2),
+                    y + rng.random_range(-0.2..0.2),
+                    0.0,
+                ]
+            })
+            .collect();
+        // A noisy line x ≈ 20 in noisy sharpness.
+        let sharpness: Vec<f64> = points
+            .iter()
+            .map(|p| {
+                let base: f64 = if (p[0] - 20.0).abs() < 0.7 { 2.0 } else { 0.5 };
+                base * rng.random_range(0.4f64..2.5)
+            })
+            .collect();
+        let nbrs = knn(&points, 16).unwrap();
+        let params = Regularize::noisy();
+        let whole = regularize(&points, &nbrs, &sharpness, &params).unwrap();
+        assert_eq!(
+            regularize_fixed(&points, &nbrs, &sharpness, &params, None).unwrap(),
+            whole
+        );
+        assert!(whole.iter().any(|&l| l) && whole.iter().any(|&l| !l));
+        let fixed: Vec<Option<bool>> = (0..points.len())
+            .map(|i| (i % 3 != 0).then_some(whole[i]))
+            .collect();
+        let part = regularize_fixed(&points, &nbrs, &sharpness, &params, Some(&fixed)).unwrap();
+        assert_eq!(part, whole);
+        // A fixed label against the data stays.
+        let lone = (0..points.len())
+            .find(|&i| !whole[i] && i % 3 != 0)
+            .unwrap();
+        let mut forced = fixed.clone();
+        forced[lone] = Some(true);
+        let part = regularize_fixed(&points, &nbrs, &sharpness, &params, Some(&forced)).unwrap();
+        assert!(part[lone]);
+        assert!(regularize_fixed(&points, &nbrs, &sharpness, &params, Some(&fixed[1..])).is_err());
     }
 }

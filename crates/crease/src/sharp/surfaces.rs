@@ -227,7 +227,52 @@ pub fn refine_with(
     sharpness: &mut [f64],
 ) -> Result<SurfaceReport> {
     check_refine(points, nbrs, params, sharp, sharpness)?;
+    let (decided, report) = decide(points, nbrs, seg, noisy, params)?;
+    apply(&decided, sharp, sharpness);
+    Ok(report)
+}
+
+/// A point's label and sharpness where the surfaces decide it, `None` where the detector's
+/// decision stands.
+pub(crate) type Decision = Option<(bool, f64)>;
+
+/// Writes the decisions of [`decide`] over the detector's `sharp` and `sharpness`.
+pub(crate) fn apply(decided: &[Decision], sharp: &mut [bool], sharpness: &mut [f64]) {
+    for (i, d) in decided.iter().enumerate() {
+        if let Some((label, s)) = *d {
+            sharp[i] = label;
+            sharpness[i] = s;
+        }
+    }
+}
+
+/// The decisions of steps 1–6 of the module documentation: per point, its label and
+/// sharpness where the surfaces (or the rim of a sheet) decide it, `None` where the detector's
+/// decision stands.
+///
+/// Errors: as [`refine_with`].
+pub(crate) fn decide(
+    points: &[Point3],
+    nbrs: &Neighborhoods,
+    seg: &PointSegmentation,
+    noisy: bool,
+    params: &SurfaceRefine,
+) -> Result<(Vec<Decision>, SurfaceReport)> {
     let n = points.len();
+    if nbrs.len() != n {
+        return Err(Error::InvalidArgument(format!(
+            "sharp surfaces: {} neighbour lists for {n} points",
+            nbrs.len()
+        )));
+    }
+    params.validate()?;
+    if params.k > nbrs.k() {
+        return Err(Error::InvalidArgument(format!(
+            "sharp surfaces: k = {} must be in 1..={}",
+            params.k,
+            nbrs.k()
+        )));
+    }
     let k = params.k;
     if seg.point_surface.len() != n {
         return Err(Error::InvalidArgument(format!(
@@ -315,7 +360,7 @@ pub fn refine_with(
     // Gap filling only where the core band is narrower than one spacing (see the module
     // documentation).
     let fill = 2.0 * (params.edge_band + sigma) < 1.0;
-    let decided: Vec<Option<(bool, f64)>> = (0..n)
+    let mut decided: Vec<Decision> = (0..n)
         .into_par_iter()
         .with_min_len(256)
         .map(|i| {
@@ -345,14 +390,7 @@ pub fn refine_with(
             })
         })
         .collect();
-    let mut explained = 0;
-    for (i, d) in decided.into_iter().enumerate() {
-        if let Some((label, s)) = d {
-            sharp[i] = label;
-            sharpness[i] = s;
-            explained += 1;
-        }
-    }
+    let mut explained = decided.iter().filter(|d| d.is_some()).count();
     // Noisy clouds: the regions the segmentation left unassigned (the point, or most of its
     // neighbours) are decided by the distance to a sheet's rim (see the module documentation).
     let mut rim = 0;
@@ -384,24 +422,24 @@ pub fn refine_with(
             },
         )?;
         for (i, d) in rim_decided.into_iter().enumerate() {
-            if let Some((label, s)) = d {
-                if edge[i].is_some() {
+            if d.is_some() {
+                if decided[i].is_some() {
                     explained -= 1;
                 }
-                sharp[i] = label;
-                sharpness[i] = s;
+                decided[i] = d;
                 rim += 1;
             }
         }
     }
-    Ok(SurfaceReport {
+    let report = SurfaceReport {
         surfaces: seg.surfaces.len(),
         assigned,
         explained,
         rim,
         sigma,
         seconds: start.elapsed().as_secs_f64(),
-    })
+    };
+    Ok((decided, report))
 }
 
 /// Sharp when `distance` < `band`; the sharpness band / distance (≥ 1 exactly for sharp points,
