@@ -167,11 +167,22 @@ fn check_refine(
     sharpness: &[f64],
 ) -> Result<()> {
     let n = points.len();
-    if sharp.len() != n || sharpness.len() != n || nbrs.len() != n {
+    if sharp.len() != n || sharpness.len() != n {
         return Err(Error::InvalidArgument(format!(
-            "sharp surfaces: {} labels, {} sharpness values, {} neighbour lists for {n} points",
+            "sharp surfaces: {} labels, {} sharpness values for {n} points",
             sharp.len(),
             sharpness.len(),
+        )));
+    }
+    check_inputs(points, nbrs, params)
+}
+
+/// The neighbour lists (one per point, at least `k` long) and the parameters.
+fn check_inputs(points: &[Point3], nbrs: &Neighborhoods, params: &SurfaceRefine) -> Result<()> {
+    let n = points.len();
+    if nbrs.len() != n {
+        return Err(Error::InvalidArgument(format!(
+            "sharp surfaces: {} neighbour lists for {n} points",
             nbrs.len()
         )));
     }
@@ -258,21 +269,8 @@ pub(crate) fn decide(
     noisy: bool,
     params: &SurfaceRefine,
 ) -> Result<(Vec<Decision>, SurfaceReport)> {
+    check_inputs(points, nbrs, params)?;
     let n = points.len();
-    if nbrs.len() != n {
-        return Err(Error::InvalidArgument(format!(
-            "sharp surfaces: {} neighbour lists for {n} points",
-            nbrs.len()
-        )));
-    }
-    params.validate()?;
-    if params.k > nbrs.k() {
-        return Err(Error::InvalidArgument(format!(
-            "sharp surfaces: k = {} must be in 1..={}",
-            params.k,
-            nbrs.k()
-        )));
-    }
     let k = params.k;
     if seg.point_surface.len() != n {
         return Err(Error::InvalidArgument(format!(
