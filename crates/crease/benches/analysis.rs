@@ -1,19 +1,17 @@
-//! The whole cloud job from one shared analysis, as `crease run` does it: a `CloudAnalysis`
-//! (Morton order, one kNN query at k = 40, normals, noise, segmentation), the sharp points
-//! (`sharp::detect`) and the curve network of sharp and fillet lines
-//! (`fillets::extract_fillets_from` with the sharp lines), on the synthetic fillet-chamfer-cone
-//! part with 10k, 100k and 1M points in sampling (random) order; clean (group
-//! `run_clean`) and with Gaussian noise of half a spacing along the normal (group
-//! `run_noisy`). File reading and writing are not included.
+//! The whole cloud job from one shared analysis, as `crease run` does it
+//! (`pipeline::run_cloud`): a `CloudAnalysis` (Morton order, one kNN query at k = 40, normals,
+//! noise, segmentation), the sharp points, the B-rep and the curve network anchored on it, on
+//! the synthetic fillet-chamfer-cone part with 10k, 100k and 1M points in sampling (random)
+//! order; clean (group `run_clean`) and with Gaussian noise of half a spacing along the normal
+//! (group `run_noisy`). File reading and writing are not included.
 //!
 //! Run with `cargo bench -p crease --bench analysis`.
 
 use std::hint::black_box;
 
 use crease::analysis::{AnalysisParams, CloudAnalysis};
-use crease::fillets::{extract_fillets_from, FilletParams};
 use crease::geometry::Point3;
-use crease::sharp::{detect, SharpParams};
+use crease::pipeline::run_cloud;
 use crease::synth::{self, Noise, NoiseScale, SampleParams, Shape};
 use criterion::{criterion_group, criterion_main, Criterion};
 
@@ -36,10 +34,8 @@ fn part(n: usize, noise: Noise) -> Vec<Point3> {
 /// Everything `crease run` computes on a cloud.
 fn whole_job(points: &[Point3]) -> usize {
     let a = CloudAnalysis::new(points, AnalysisParams::default()).expect("analysis");
-    let surfaces = a.segmentation().expect("segmentation").surfaces.len();
-    let sharp = detect(&a, &SharpParams::default()).expect("sharp");
-    let net = extract_fillets_from(&a, &FilletParams::default(), true).expect("network");
-    surfaces + sharp.num_sharp() + net.lines.polylines.len()
+    let run = run_cloud(&a, |_| {}).expect("run");
+    run.surfaces.len() + run.sharp.num_sharp() + run.network.polylines.len()
 }
 
 fn run(c: &mut Criterion) {
