@@ -70,7 +70,7 @@ pub(crate) const RICHER_GAIN: f64 = 1.15;
 pub(crate) const MERGE_SLACK: f64 = 1.1;
 
 /// Graph edges two regions must share to be tried as one.
-const MIN_CONTACT: usize = 3;
+pub(crate) const MIN_CONTACT: usize = 3;
 
 /// Most points of each part a fit reads.
 const PART_SAMPLE: usize = 512;

@@ -56,6 +56,7 @@
 //! [`crate::geometry::SurfaceType`]: plane 0, cylinder 1, cone 2, sphere 3, torus 4,
 //! 255 unassigned.
 
+mod blend;
 pub mod fit;
 pub mod grow;
 pub mod labels;
@@ -897,6 +898,12 @@ pub(crate) fn segment_graph<G: Adjacency>(
         // The merged surfaces explain more: the crease bands they leave are dissolved again.
         if input.dissolve_crease_bands && (richer || merged || plainer) {
             dissolve_crease_bands(input, &ctx, &mut owner, &mut explained, &mut regions);
+        }
+        // Rounded edges the growing did not find, fitted from their planes (`blend`), on
+        // clouds, by the points' own noise (the seeds' overstates it where they straddle
+        // surfaces).
+        if let Some(noise) = input.noise {
+            blend::blends(&ctx, &mut owner, &mut regions, noise, floor, l);
         }
         timings.push(("merge", t.elapsed().as_secs_f64()));
     }

@@ -49,10 +49,10 @@ const PARALLEL_DEGREES: f64 = 10.0;
 
 /// The planes a fillet is tangent to: (normal, offset, side), `side` the sign `s` with which
 /// the centre satisfies `n · c = offset − s r`.
-type Tangent = (Point3, f64, f64);
+pub(super) type Tangent = (Point3, f64, f64);
 
 /// Solves the 3 × 3 system with rows `m` for `rhs` (Cramer), if it is well conditioned.
-fn solve3(m: [Point3; 3], rhs: Point3) -> Option<Point3> {
+pub(super) fn solve3(m: [Point3; 3], rhs: Point3) -> Option<Point3> {
     let det = dot(m[0], cross(m[1], m[2]));
     if det.abs() < 1e-6 {
         return None;
@@ -97,7 +97,7 @@ fn residuals(part: &Part, s: &SurfaceParams) -> Vec<f64> {
 }
 
 /// Gauss–Newton in `r` from `r0`: the tangent surface that fits `part` best, and its RMS.
-fn fit_radius(
+pub(super) fn fit_radius(
     part: &Part,
     planes: &[Tangent],
     axis: Option<(Point3, f64)>,

@@ -133,6 +133,18 @@ fn fillet_borders_under_half_a_spacing_of_noise() {
     assert_eq!(r.summary.joined_smooth_ends, 4, "{:?}", r.summary);
 }
 
+/// The same part at a whole spacing of noise along the normal: the growing types the fillet
+/// as a cone of half angle 1.2°, which no tangency test takes; fitted from its two planes
+/// (`segment::blend`) it is their rounded edge of radius 0.1, and the network is exact again.
+/// (Before: 17 sharp lines and 2 boundary pieces, the least coverage of a curve 0.02.)
+#[test]
+fn fillet_borders_under_a_whole_spacing_of_noise() {
+    let p = part("fillet-chamfer-cone", 100_000, Noise::AlongNormal(1.0));
+    let r = assert_exact("fillet-chamfer-cone, normal 1", &p, 12);
+    assert_eq!(r.summary.smooth_polylines, 2, "{:?}", r.summary);
+    assert_eq!(r.summary.joined_smooth_ends, 4, "{:?}", r.summary);
+}
+
 /// A RealSense scan of a cardboard box seen from one side (46k points): Demarsin's graph draws
 /// 224 meandering sharp polylines over its faces; anchored on the surfaces, the box's three
 /// visible edges come out as three straight lines meeting at its corner, with a handful of
