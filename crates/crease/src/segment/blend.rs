@@ -1,33 +1,36 @@
-//! Rounded edges recovered from the planes they round (not in the paper; issue 29).
+//! Rounded edges recovered from the planes they round, on noisy clouds (not in the paper;
+//! issue 29).
 //!
-//! Under noise of half a spacing and more the region growing does not see a fillet: its points
+//! Under noise of half a spacing and more the region growing may not see a fillet: its points
 //! leave the planes beside it by `r (1 − cos θ)`, within the widened tolerances for tens of
 //! degrees, so the planes take its flanks and whatever fit takes the rest is no fillet (the
-//! rounded cube at σ = 0.5 spacings: a cone about a corner's diagonal holding the corner and
-//! its three fillets, and no corner ball anywhere; at σ = 1: its six planes and nothing else).
-//! A designer's blend is fixed by the planes it rounds and one radius, so it is fitted as such,
-//! on all the points about it instead of on a region the noise drew:
-//! - every pair of non-parallel planes that touch, directly or through regions that are not
-//!   planes, and that no tangent cylinder joins yet, is given the **rounded edge** of radius
-//!   `r` that fits their points and those between best (a search in `r` of a truncated least
-//!   squares cost, each point measured to the part of the rounded edge whose zone holds it:
-//!   the cylinder within the angle its two tangent lines subtend from the axis, else the plane
-//!   on its side); the edge is rounded when the cylinder explains the points of its zone
-//!   [`ROUNDED_GAIN`] times better than the sharp edge, within the noise, and the zone holds
-//!   at least [`MIN_BLEND_POINTS`];
-//! - rounded edges that close a triangle of rounded edges (a rounded corner, where a ball
-//!   would meet three cylinders) are left to the region growing for now: the B-rep does not
-//!   yet build the vertices where four tangent surfaces meet (a trial with corner balls made
-//!   the noisy rounded cube's segmentation exact but its B-rep an open shell,
+//! fillet-chamfer-cone part at a whole spacing: a cone of half angle 1.2°, which no tangency
+//! test takes). A designer's fillet is fixed by the two planes it rounds and one radius, so it
+//! is fitted as such, on all the points about it instead of on a region the noise drew:
+//! - every pair of non-parallel planes that touch (directly, through regions that are not
+//!   planes, or across a set of unassigned vertices) and that no tangent cylinder joins yet
+//!   is given the **rounded edge** of radius `r` that fits their points and those between
+//!   best: a geometric grid in `r`, then a golden-section search, of a truncated
+//!   least-squares cost in which each point is measured to the part of the rounded edge whose
+//!   *zone* holds it (the cylinder inside the wedge its two tangent lines subtend from the
+//!   axis, else the plane on its side);
+//! - the edge is kept when, over its zone, it beats the sharp edge by [`ROUNDED_GAIN`] noise
+//!   scales in quadrature, its cylinder's robust residual scale is within [`ROUND_SLACK`]
+//!   times the noise, and the zone holds at least [`MIN_BLEND_POINTS`];
+//! - a new edge that closes a triangle of rounded edges (a rounded corner, where a ball would
+//!   meet three cylinders) is left to the region growing: the B-rep does not yet build the
+//!   vertices where four tangent surfaces meet (with corner balls the noisy rounded cube's
+//!   segmentation came out exact but its B-rep an open shell; the trial and its patch are in
 //!   `docs/experiments/noisy-segmentation.md`);
 //! - the points go to the zones, not to the nearest surface: within about `√(2 r σ)` of a
 //!   tangent border the noise, not the geometry, decides which surface is nearer. A point
-//!   moves only when
-//!   its zone's surface lies within [`GATE_SIGMAS`] noise scales of where its own does (a face
-//!   that runs on past the end of a rounded edge keeps its points).
+//!   moves only when its zone's surface lies within [`GATE_SIGMAS`] noise scales of where its
+//!   own does (a face that runs on past the end of a rounded edge keeps its points).
 //!
 //! The planes are then refitted on what is left to them, the radii on their zones (tangent to
-//! the planes, as in [`super::tangent`]), and the zones drawn again once.
+//! the planes, as in [`super::tangent`]), and the zones drawn again once. The noise is the
+//! points' own (`estimate::noise::noise_sigma`): the seeds' overstates it where they straddle
+//! surfaces (0.0134 for 0.0015 on the rounded cube at a fifth of a spacing).
 
 use rayon::prelude::*;
 
