@@ -102,7 +102,7 @@ struct Edge {
     /// The axis direction and a point of the axis.
     dir: Point3,
     centre: Point3,
-    /// The cylinder's region (an existing one or the one made for it).
+    /// The cylinder's region (made for it).
     region: usize,
     /// Regions whose points the edge may take: its planes, its cylinder, those between.
     from: Vec<usize>,
@@ -156,30 +156,27 @@ fn plane(regions: &[Region], i: usize) -> Option<(Point3, f64)> {
 }
 
 /// Whether the surface of region `j` already rounds the edge of planes `a`, `b` (a cylinder
-/// along it, or a sphere, at its radius from both); its radius and centre if so.
-fn rounds(
-    regions: &[Region],
-    j: usize,
-    a: (Point3, f64),
-    b: (Point3, f64),
-) -> Option<(f64, Point3)> {
+/// along it, or a sphere, at its radius from both).
+fn rounds(regions: &[Region], j: usize, a: (Point3, f64), b: (Point3, f64)) -> bool {
     let (c, r) = match regions[j].fit.params {
         SurfaceParams::Cylinder {
             axis_point,
             axis_dir,
             radius,
         } => {
-            let d = normalize(cross(a.0, b.0))?;
+            let Some(d) = normalize(cross(a.0, b.0)) else {
+                return false;
+            };
             if dot(d, axis_dir).abs() < AXIS_DEGREES.to_radians().cos() {
-                return None;
+                return false;
             }
             (axis_point, radius)
         }
         SurfaceParams::Sphere { center, radius } => (center, radius),
-        _ => return None,
+        _ => return false,
     };
     let off = |(n, o): (Point3, f64)| ((dot(n, c) - o).abs() - r).abs();
-    (off(a) <= TANGENT_TOLERANCE * r && off(b) <= TANGENT_TOLERANCE * r).then_some((r, c))
+    off(a) <= TANGENT_TOLERANCE * r && off(b) <= TANGENT_TOLERANCE * r
 }
 
 /// The vertices of regions `from`, concatenated.
@@ -497,7 +494,7 @@ pub(crate) fn blends<G: Adjacency>(
     let parallel = PARALLEL_DEGREES.to_radians().cos();
     // Pairs of planes that touch, directly or through regions that are not planes.
     let mut pairs: Vec<(usize, usize, Vec<usize>)> = Vec::new();
-    let mut existing: Vec<Edge> = Vec::new();
+    let mut existing: Vec<(usize, usize)> = Vec::new();
     for pa in 0..nreg {
         let Some(a) = plane(regions, pa) else {
             continue;
@@ -522,31 +519,12 @@ pub(crate) fn blends<G: Adjacency>(
                 .copied()
                 .filter(|j| neighbours[pb].contains(j) && plane(regions, *j).is_none())
                 .collect();
-            // An existing tangent cylinder rounds the edge already: kept, for the corners.
-            let tangent = common.iter().find_map(|&j| {
-                matches!(regions[j].kind, SurfaceType::Cylinder)
-                    .then(|| rounds(regions, j, a, b).map(|(r, c)| (j, r, c)))
-                    .flatten()
-            });
-            if let Some((j, r, c)) = tangent {
-                let side = |(n, o): (Point3, f64), region| Side {
-                    region,
-                    n,
-                    o,
-                    s: if dot(n, c) >= o { 1.0 } else { -1.0 },
-                };
-                let (sa, sb) = (side(a, pa), side(b, pb));
-                if let Some((dir, centre)) = edge_axis(&sa, &sb, r, c) {
-                    existing.push(Edge {
-                        a: sa,
-                        b: sb,
-                        r,
-                        dir,
-                        centre,
-                        region: j,
-                        from: vec![pa, pb, j],
-                    });
-                }
+            // A tangent cylinder rounds the edge already: recorded, for the corners.
+            if common
+                .iter()
+                .any(|&j| regions[j].kind == SurfaceType::Cylinder && rounds(regions, j, a, b))
+            {
+                existing.push((pa, pb));
                 continue;
             }
             // Regions between that already round something else stay out.
@@ -557,8 +535,7 @@ pub(crate) fn blends<G: Adjacency>(
                         x != pa
                             && x != pb
                             && plane(regions, x).is_some_and(|xp| {
-                                rounds(regions, j, a, xp).is_some()
-                                    || rounds(regions, j, b, xp).is_some()
+                                rounds(regions, j, a, xp) || rounds(regions, j, b, xp)
                             })
                     })
                 })
@@ -576,7 +553,8 @@ pub(crate) fn blends<G: Adjacency>(
     // A new edge that closes a triangle of rounded edges rounds a corner: left out (see the
     // module documentation).
     let key = |e: &Edge| (e.a.region.min(e.b.region), e.a.region.max(e.b.region));
-    let mut rounded: Vec<(usize, usize)> = existing.iter().chain(&new).map(key).collect();
+    let mut rounded: Vec<(usize, usize)> =
+        existing.into_iter().chain(new.iter().map(key)).collect();
     rounded.sort_unstable();
     let is_rounded = |a: usize, b: usize| rounded.binary_search(&(a.min(b), a.max(b))).is_ok();
     let mut edges: Vec<Edge> = new
